@@ -5,6 +5,16 @@ is one connected region, each interior ring one obstacle (a hole of the free spa
 Its true Betti numbers follow from the geometry: beta_0 = number of regions,
 beta_1 = number of holes.  Nothing downstream of the encounter log may look at it;
 the simulator uses it, and pictures and scoring use it as ground truth.
+
+Generators (all lengths in mm; generated arenas have the lower-left corner of their
+outer wall's bounding box at the origin, except :func:`annulus_arena`):
+
+* :func:`square_arena` -- a square with the holes you give;
+* :func:`default_arena` -- the one-hole arena of the paper's Fig. "encmds";
+* :func:`random_arena` -- k non-overlapping holes at random places, as in the paper's
+  experiments (random placements of square holes, scaled environments);
+* :func:`annulus_arena` -- a ring, the paper's Fig. "enc" (nodes on an annulus);
+* :func:`two_rooms_arena` -- two disjoint rooms (beta_0 = 2).
 """
 
 from __future__ import annotations
@@ -19,7 +29,7 @@ import shapely.validation
 from shapely.geometry import LinearRing, MultiPolygon, Polygon, mapping, shape
 from shapely.geometry.polygon import orient
 
-from .errors import ArenaError
+from .errors import ArenaError, SwarmtopoError
 
 
 class Arena:
@@ -30,7 +40,9 @@ class Arena:
     geometry
         A shapely ``Polygon`` or ``MultiPolygon``.  Rings must be simple, every hole
         must lie strictly inside its shell, holes must not touch each other or the
-        shell, and regions must not touch each other.
+        shell, and regions must not touch each other.  Z coordinates and repeated
+        consecutive vertices are dropped; shells are stored counter-clockwise and
+        holes clockwise.
     source
         Name used in error messages (e.g. the GeoJSON file name).
 
@@ -74,7 +86,9 @@ class Arena:
     def boundary_segments(self) -> np.ndarray:
         """All boundary edges (outer walls and obstacle walls) as an (M, 4) array.
 
-        Row ``[x0, y0, x1, y1]``; float64, C-contiguous, read-only.
+        Row ``[x0, y0, x1, y1]``; float64, C-contiguous, read-only.  One row per ring
+        edge.  Shells run counter-clockwise and holes clockwise, so the free space
+        always lies to the left of the direction (x0, y0) -> (x1, y1).
         """
         rows = []
         for region in self.regions:
@@ -105,8 +119,12 @@ class Arena:
     def sample_uniform(self, n: int, rng=None, *, clearance: float = 0.0) -> np.ndarray:
         """Draw ``n`` points uniformly in the free space, at least ``clearance`` mm from walls.
 
-        Rejection sampling in the bounding box; returns an (n, 2) float64 array.
+        Rejection sampling in the bounding box of the free space shrunk by
+        ``clearance``; returns an (n, 2) float64 array.  The clearance is tested
+        exactly (the shrunk polygon cuts the rounded corners with chords).
         """
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0:
+            raise ArenaError(f"number of points must be a non-negative integer, got {n!r}")
         rng = np.random.default_rng(rng)
         region = self.geometry.buffer(-clearance) if clearance > 0 else self.geometry
         if region.is_empty:
@@ -119,11 +137,15 @@ class Arena:
             m = int((n - len(out)) / accept_rate * 1.2) + 16
             cand = np.column_stack([rng.uniform(xmin, xmax, m), rng.uniform(ymin, ymax, m)])
             keep = shapely.contains_xy(region, cand[:, 0], cand[:, 1])
+            if clearance > 0:
+                keep[keep] = self.distance_to_boundary(cand[keep, 0], cand[keep, 1]) >= clearance
             out = np.vstack([out, cand[keep]])
         return out[:n]
 
     def scaled(self, factor: float) -> "Arena":
-        """The same arena scaled by ``factor`` about the origin."""
+        """The same arena scaled by ``factor`` (> 0) about the origin."""
+        if not (np.isfinite(factor) and factor > 0):
+            raise ArenaError(f"scale factor must be a positive number, got {factor!r}")
         return Arena(shapely.affinity.scale(self.geometry, factor, factor, origin=(0, 0)))
 
     # -- GeoJSON -------------------------------------------------------------------
@@ -142,13 +164,17 @@ class Arena:
             raise ArenaError("not a GeoJSON object (no 'type' member)", file=source)
         kind = obj["type"]
         if kind == "FeatureCollection":
-            feats = obj.get("features") or []
-            geoms = [f.get("geometry") for f in feats if isinstance(f, dict)]
-            geoms = [g for g in geoms if g]
-            if not geoms:
-                raise ArenaError("FeatureCollection holds no geometry", file=source)
-            parts = [_geometry_from(g, source) for g in geoms]
-            polys = [p for g in parts for p in getattr(g, "geoms", [g])]
+            feats = obj.get("features")
+            if not isinstance(feats, list) or not feats:
+                raise ArenaError("FeatureCollection holds no features", file=source)
+            polys = []
+            for i, feat in enumerate(feats):
+                if not isinstance(feat, dict) or feat.get("type") != "Feature":
+                    raise ArenaError(f"feature {i} is not a GeoJSON Feature", file=source)
+                if not feat.get("geometry"):
+                    raise ArenaError(f"feature {i} has no geometry", file=source)
+                geom = _geometry_from(feat["geometry"], source, f"feature {i}: ")
+                polys.extend(geom.geoms if isinstance(geom, MultiPolygon) else [geom])
             return cls(MultiPolygon(polys), source=source)
         if kind == "Feature":
             if not obj.get("geometry"):
@@ -172,16 +198,340 @@ class Arena:
     __hash__ = None
 
 
-def _geometry_from(obj: dict, source) -> Polygon | MultiPolygon:
-    if obj.get("type") not in ("Polygon", "MultiPolygon"):
-        raise ArenaError(
-            f"geometry type {obj.get('type')!r} is not supported; expected Polygon or MultiPolygon",
-            file=source,
-        )
+# -- generators ------------------------------------------------------------------------
+HOLE_SHAPES: tuple[str, ...] = ("square", "disc", "L", "triangle", "wall")
+"""Hole families of :func:`random_arena`; see there for their sizes and orientations."""
+OUTER_SHAPES: tuple[str, ...] = ("square", "rectangle", "polygon")
+"""Outer walls of :func:`random_arena`, all of area ``side**2``."""
+PLACEMENT_TRIES = 20_000
+"""Default budget of candidate holes drawn by :func:`random_arena` before giving up."""
+
+_DISC_SEGMENTS = 64   # a disc hole is a regular 64-gon: its area is 0.16 % below the disc's
+_TRIES_PER_HOLE = 100  # candidates for one hole before the whole layout is redrawn
+_HOLE_FRACTION = 0.25  # default hole size / side: 125 mm holes in the 500 mm arena
+_CLEARANCE_FRACTION = 0.12  # default clearance / side: 60 mm = 2 r_d in the 500 mm arena
+_GAP_FRACTION = 0.2  # default gap between the two rooms / side: 100 mm > r_d at side 500
+
+
+def square_arena(side: float = 500.0, holes=()) -> Arena:
+    """The square [0, side]^2 with the given holes.
+
+    Parameters
+    ----------
+    side
+        Side length, mm.
+    holes
+        Iterable of shapely Polygons (their outer rings become the obstacles); they
+        must lie strictly inside the square and not touch each other.
+    """
+    side = _positive(side, "side")
+    rings = [Polygon(h).exterior for h in holes]
+    return Arena(Polygon(shapely.box(0.0, 0.0, side, side).exterior, rings))
+
+
+def default_arena() -> Arena:
+    """The demo arena: the paper's one-hole environment (Fig. "encmds").
+
+    The paper gives no dimensions; we use a 500 mm square with one centred,
+    axis-aligned square hole of side 150 mm -- the same 500 mm scale as the paper's
+    motion parameters (v_c = 15 mm/s, l* = 30 mm) and detection radius r_d = 30 mm.
+    True Betti numbers (1, 1).
+    """
+    return square_arena(500.0, [shapely.box(175.0, 175.0, 325.0, 325.0)])
+
+
+def random_arena(
+    n_holes: int,
+    *,
+    scale: float = 1.0,
+    rng=None,
+    side: float = 500.0,
+    hole_size: float | None = None,
+    clearance: float | None = None,
+    shapes=("square",),
+    outer: str = "square",
+    max_tries: int = PLACEMENT_TRIES,
+) -> Arena:
+    """An arena with ``n_holes`` non-overlapping holes at random places.
+
+    As in the paper's experiments (random placements of square holes in a square
+    environment, scaled copies of it).  Every hole keeps at least ``clearance`` from
+    every other hole and from the outer wall, so agents can pass everywhere.
+
+    Parameters
+    ----------
+    n_holes
+        Number of holes k (the true beta_1).
+    scale
+        The paper's scale factor: multiplies every length (side, hole size,
+        clearance), so areas grow with ``scale**2``.  The lengths below are before
+        scaling.
+    rng
+        Seed or Generator; the same seed gives the same arena.
+    side
+        Side of the square outer wall (mm); the other outer walls have area ``side**2``.
+    hole_size
+        Size s of each hole (mm), default ``0.25 * side`` (125 mm): the side of a
+        square, the diameter of a disc (a 64-gon), the side of the bounding square of
+        an L (arms s/2 wide), the side of an equilateral triangle, the length of a wall
+        (a thin s x 0.1 s rectangle).
+    clearance
+        Minimum distance (mm) between holes and between a hole and the outer wall;
+        default ``0.12 * side`` (60 mm = 2 r_d for the default r_d = 30 mm).
+    shapes
+        Hole families to draw from, uniformly and independently per hole (see
+        HOLE_SHAPES).  Squares and discs are axis-aligned, like the paper's square
+        holes; L, triangle and wall get a uniformly random orientation.
+    outer
+        ``"square"``; ``"rectangle"`` (aspect ratio uniform in 1:1 .. 1:2, the long side
+        along x); ``"polygon"`` (a random star-shaped polygon of 5--9 corners, convex or
+        mildly non-convex: corner radii vary by +-20 %).
+    max_tries
+        Budget of candidate holes.  Holes are placed one by one by rejection sampling;
+        after 100 failed candidates for one hole the layout is redrawn from scratch.
+
+    Raises
+    ------
+    SwarmtopoError
+        If the holes cannot be placed within ``max_tries`` candidates, or on bad
+        arguments.
+    """
+    rng = np.random.default_rng(rng)
+    n_holes = _count(n_holes, "n_holes")
+    scale, side = _positive(scale, "scale"), _positive(side, "side")
+    size = _positive(_HOLE_FRACTION * side if hole_size is None else hole_size, "hole_size")
+    clear = _non_negative(_CLEARANCE_FRACTION * side if clearance is None else clearance, "clearance")
+    shapes = _hole_shapes(shapes)
+    if outer not in OUTER_SHAPES:
+        raise SwarmtopoError(f"unknown outer wall {outer!r}; expected one of {', '.join(OUTER_SHAPES)}")
+    wall, what = _outer_polygon(outer, side, scale, rng)
+    holes = _place_holes(wall, n_holes, size, clear, shapes, rng, _count(max_tries, "max_tries"))
+    if holes is None:
+        raise SwarmtopoError(_placement_failure(n_holes, size * scale, clear * scale, what, max_tries))
+    arena = Arena(Polygon(wall.exterior, [h.exterior for h in holes]))
+    return arena if scale == 1.0 else arena.scaled(scale)
+
+
+def annulus_arena(r_outer: float, r_inner: float, *, segments: int = 128, center=(0.0, 0.0)) -> Arena:
+    """A ring r_inner < |p - center| < r_outer: the paper's Fig. "enc" (nodes on an annulus).
+
+    Both circles are regular ``segments``-gons with corners on the circles (so the
+    area is slightly below pi (r_outer^2 - r_inner^2)).  True Betti numbers (1, 1).
+    """
+    r_outer, r_inner = _positive(r_outer, "r_outer"), _positive(r_inner, "r_inner")
+    if r_inner >= r_outer:
+        raise SwarmtopoError(f"r_inner must be smaller than r_outer, got {r_inner:g} >= {r_outer:g}")
+    segments = _count(segments, "segments")
+    if segments < 3:
+        raise SwarmtopoError(f"segments must be at least 3, got {segments}")
+    cx, cy = (float(c) for c in center)
+    outer = _regular_polygon(segments, r_outer, 0.0)
+    inner = _regular_polygon(segments, r_inner, 0.0)
+    return Arena(shapely.affinity.translate(Polygon(outer.exterior, [inner.exterior]), cx, cy))
+
+
+def two_rooms_arena(
+    side: float = 500.0,
+    gap: float | None = None,
+    *,
+    scale: float = 1.0,
+    rng=None,
+    n_holes=0,
+    hole_size: float | None = None,
+    clearance: float | None = None,
+    shapes=("square",),
+    max_tries: int = PLACEMENT_TRIES,
+) -> Arena:
+    """Two disjoint square rooms side by side (beta_0 = 2), optionally with random holes.
+
+    Room 0 is [0, side]^2, room 1 is [side + gap, 2 side + gap] x [0, side].
+
+    Parameters
+    ----------
+    side
+        Side of each room (mm).
+    gap
+        Distance between the rooms (mm), default ``0.2 * side`` (100 mm, well above
+        r_d, so agents in different rooms never meet).
+    scale
+        Multiplies every length, as in :func:`random_arena`.
+    n_holes
+        Total number of holes, room 0 getting the extra one when odd; or a pair
+        ``(holes in room 0, holes in room 1)``.
+    hole_size, clearance, shapes, max_tries
+        As in :func:`random_arena` (square holes only by default; the budget is per room).
+    """
+    rng = np.random.default_rng(rng)
+    scale, side = _positive(scale, "scale"), _positive(side, "side")
+    gap = _positive(_GAP_FRACTION * side if gap is None else gap, "gap")
+    if isinstance(n_holes, (tuple, list)) and len(n_holes) == 2:
+        per_room = [_count(n_holes[0], "n_holes[0]"), _count(n_holes[1], "n_holes[1]")]
+    else:
+        total = _count(n_holes, "n_holes")
+        per_room = [total - total // 2, total // 2]
+    size = _positive(_HOLE_FRACTION * side if hole_size is None else hole_size, "hole_size")
+    clear = _non_negative(_CLEARANCE_FRACTION * side if clearance is None else clearance, "clearance")
+    shapes = _hole_shapes(shapes)
+    max_tries = _count(max_tries, "max_tries")
+    rooms = []
+    for k, offset in enumerate((0.0, side + gap)):
+        wall = shapely.box(offset, 0.0, offset + side, side)
+        holes = _place_holes(wall, per_room[k], size, clear, shapes, rng, max_tries)
+        if holes is None:
+            what = f"{side * scale:g} mm square room"
+            raise SwarmtopoError(_placement_failure(per_room[k], size * scale, clear * scale, what, max_tries))
+        rooms.append(Polygon(wall.exterior, [h.exterior for h in holes]))
+    arena = Arena(MultiPolygon(rooms))
+    return arena if scale == 1.0 else arena.scaled(scale)
+
+
+def _outer_polygon(outer: str, side: float, scale: float, rng) -> tuple[Polygon, str]:
+    """The outer wall (area side^2, bounding box from the origin) and its description."""
+    if outer == "square":
+        return shapely.box(0.0, 0.0, side, side), f"{side * scale:g} mm square"
+    if outer == "rectangle":
+        aspect = rng.uniform(1.0, 2.0)
+        w, h = side * np.sqrt(aspect), side / np.sqrt(aspect)
+        return shapely.box(0.0, 0.0, w, h), f"{w * scale:.0f} x {h * scale:.0f} mm rectangle"
+    n = int(rng.integers(5, 10))
+    step = 2 * np.pi / n
+    angles = step * (np.arange(n) + rng.uniform(-0.3, 0.3, n)) + rng.uniform(0, 2 * np.pi)
+    radii = rng.uniform(0.8, 1.2, n)  # star-shaped about the origin, so always simple
+    poly = Polygon(np.column_stack([radii * np.cos(angles), radii * np.sin(angles)]))
+    poly = shapely.affinity.scale(poly, side / np.sqrt(poly.area), side / np.sqrt(poly.area), origin=(0, 0))
+    x0, y0, _, _ = poly.bounds
+    poly = shapely.affinity.translate(poly, -x0, -y0)
+    return poly, f"random {n}-corner polygon of area {(side * scale) ** 2:.0f} mm^2"
+
+
+def _place_holes(wall: Polygon, n: int, size: float, clearance: float, shapes, rng, budget: int):
+    """n holes inside ``wall``, pairwise and from the wall at least ``clearance`` apart.
+
+    Holes are placed one by one by rejection sampling; after _TRIES_PER_HOLE misses
+    for one hole the layout is redrawn from scratch.  None when ``budget`` candidates
+    fail.  A candidate is drawn with its bounding box inside the wall's bounding box
+    shrunk by ``clearance``, then tested exactly with shapely distances.
+    """
+    if n == 0:
+        return []
+    shapely.prepare(wall)
+    placed: list[Polygon] = []
+    family, misses = None, 0
+    for _ in range(budget):
+        if family is None:
+            family = shapes[int(rng.integers(len(shapes)))]
+        hole = _candidate_hole(wall, family, size, clearance, placed, rng)
+        if hole is None:
+            misses += 1
+            if misses == _TRIES_PER_HOLE:  # this hole finds no place: redraw the layout
+                placed, family, misses = [], None, 0
+            continue
+        placed.append(hole)
+        family, misses = None, 0
+        if len(placed) == n:
+            return placed
+    return None
+
+
+def _candidate_hole(wall: Polygon, family: str, size: float, clearance: float, placed, rng):
+    """A random hole of ``family`` placed in ``wall``, or None if it violates the clearance."""
+    xmin, ymin, xmax, ymax = wall.bounds
+    hole = _hole_polygon(family, size, rng)
+    bx0, by0, bx1, by1 = hole.bounds
+    lo_x, hi_x = xmin + clearance - bx0, xmax - clearance - bx1
+    lo_y, hi_y = ymin + clearance - by0, ymax - clearance - by1
+    if lo_x > hi_x or lo_y > hi_y:
+        return None
+    hole = shapely.affinity.translate(hole, rng.uniform(lo_x, hi_x), rng.uniform(lo_y, hi_y))
+    if not wall.contains(hole) or wall.exterior.distance(hole) < clearance:
+        return None
+    if placed:
+        gaps = shapely.distance(hole, placed)
+        if np.any(gaps < clearance) or np.any(gaps <= 0):
+            return None
+    return hole
+
+
+def _hole_polygon(family: str, s: float, rng) -> Polygon:
+    """One hole of size s centred near the origin (see random_arena for the families)."""
+    if family == "square":
+        return shapely.box(-s / 2, -s / 2, s / 2, s / 2)
+    if family == "disc":
+        return _regular_polygon(_DISC_SEGMENTS, s / 2, 0.0)
+    if family == "L":
+        poly = Polygon([(0, 0), (s, 0), (s, s / 2), (s / 2, s / 2), (s / 2, s), (0, s)])
+        poly = shapely.affinity.translate(poly, -s / 2, -s / 2)
+    elif family == "triangle":
+        poly = _regular_polygon(3, s / np.sqrt(3), 0.0)  # circumradius of side s
+    else:  # wall
+        poly = shapely.box(-s / 2, -s / 20, s / 2, s / 20)
+    return shapely.affinity.rotate(poly, rng.uniform(0.0, 2 * np.pi), origin=(0, 0), use_radians=True)
+
+
+def _regular_polygon(n: int, radius: float, phase: float) -> Polygon:
+    angles = phase + 2 * np.pi * np.arange(n) / n
+    return Polygon(np.column_stack([radius * np.cos(angles), radius * np.sin(angles)]))
+
+
+def _placement_failure(n: int, size: float, clearance: float, what: str, tries: int) -> str:
+    holes = "1 hole" if n == 1 else f"{n} holes"
+    return (f"cannot place {holes} of {size:g} mm with {clearance:g} mm clearance in a {what} "
+            f"after {tries} tries; use fewer or smaller holes, or a smaller clearance")
+
+
+def _hole_shapes(shapes) -> tuple[str, ...]:
+    shapes = (shapes,) if isinstance(shapes, str) else tuple(shapes)
+    unknown = [f for f in shapes if f not in HOLE_SHAPES]
+    if not shapes or unknown:
+        raise SwarmtopoError(f"unknown hole shape {unknown[0] if unknown else None!r}; "
+                             f"expected some of {', '.join(HOLE_SHAPES)}")
+    return shapes
+
+
+def _positive(value, name: str) -> float:
+    x = _number(value)
+    if not x > 0:
+        raise SwarmtopoError(f"{name} must be a positive number, got {value!r}")
+    return x
+
+
+def _non_negative(value, name: str) -> float:
+    x = _number(value)
+    if not x >= 0:
+        raise SwarmtopoError(f"{name} must be a non-negative number, got {value!r}")
+    return x
+
+
+def _number(value) -> float:
+    """float(value) if it is a finite real number, else NaN."""
+    if isinstance(value, bool):
+        return float("nan")
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        return float("nan")
+    return x if np.isfinite(x) else float("nan")
+
+
+def _count(value, name: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+        raise SwarmtopoError(f"{name} must be a non-negative integer, got {value!r}")
+    return int(value)
+
+
+def _geometry_from(obj, source, where: str = "") -> Polygon | MultiPolygon:
+    if not isinstance(obj, dict):
+        raise ArenaError(f"{where}geometry is not a GeoJSON object", file=source)
+    kind = obj.get("type")
+    if kind not in ("Polygon", "MultiPolygon"):
+        raise ArenaError(f"{where}geometry type {kind!r} is not supported; expected Polygon or MultiPolygon",
+                         file=source)
+    if "coordinates" not in obj:
+        raise ArenaError(f"{where}{kind} has no 'coordinates'", file=source)
     try:
         return shape(obj)
     except Exception as exc:  # shapely raises several types on malformed coordinates
-        raise ArenaError(f"malformed coordinates ({exc})", file=source) from None
+        raise ArenaError(f"{where}malformed coordinates ({exc})", file=source) from None
 
 
 def _validated(geometry, source) -> MultiPolygon:
@@ -190,53 +540,71 @@ def _validated(geometry, source) -> MultiPolygon:
     elif isinstance(geometry, MultiPolygon):
         polys = list(geometry.geoms)
     else:
-        raise ArenaError(f"expected a Polygon or MultiPolygon, got {geometry.geom_type}", file=source)
+        kind = getattr(geometry, "geom_type", type(geometry).__name__)
+        raise ArenaError(f"expected a Polygon or MultiPolygon, got {kind}", file=source)
     if not polys:
         raise ArenaError("the arena is empty", file=source)
     clean = []
     for i, poly in enumerate(polys):
         where = f"region {i}"
-        _check_ring(poly.exterior, f"{where} outer wall", source)
-        if poly.area <= 0:
+        shell = _clean_ring(poly.exterior, f"{where} outer wall", source)
+        filled = Polygon(shell)
+        if filled.area <= 0:
             raise ArenaError(f"{where} has zero area", file=source)
-        shell = Polygon(poly.exterior)
-        holes = [Polygon(r) for r in poly.interiors]
-        for j, (ring, hole) in enumerate(zip(poly.interiors, holes)):
-            _check_ring(ring, f"{where} hole {j}", source)
-            if not shell.contains(hole) or hole.intersects(poly.exterior):
-                pt = hole.representative_point()
+        holes = []
+        for j, ring in enumerate(poly.interiors):
+            hole = Polygon(_clean_ring(ring, f"{where} hole {j}", source))
+            if hole.area <= 0:
+                raise ArenaError(f"{where} hole {j} has zero area", file=source)
+            if not filled.contains(hole) or hole.intersects(shell):
+                contact = hole.intersection(shell)
+                pt = (contact if not contact.is_empty else hole).representative_point()
                 raise ArenaError(
                     f"{where} hole {j} is not strictly inside its outer wall (near x={pt.x:.6g}, y={pt.y:.6g})",
                     file=source,
                 )
-        for j in range(len(holes)):
-            for k in range(j + 1, len(holes)):
-                if holes[j].intersects(holes[k]):
-                    pt = holes[j].intersection(holes[k]).representative_point()
-                    raise ArenaError(
-                        f"{where} holes {j} and {k} overlap or touch (near x={pt.x:.6g}, y={pt.y:.6g})",
-                        file=source,
-                    )
+            holes.append(hole)
+        for j, k in _touching_pairs(holes):
+            pt = holes[j].intersection(holes[k]).representative_point()
+            raise ArenaError(
+                f"{where} holes {j} and {k} overlap or touch (near x={pt.x:.6g}, y={pt.y:.6g})",
+                file=source,
+            )
         # orient: shell counter-clockwise, holes clockwise
-        clean.append(orient(Polygon(poly.exterior, list(poly.interiors)), 1.0))
-    for i in range(len(clean)):
-        for k in range(i + 1, len(clean)):
-            if clean[i].intersects(clean[k]):
-                pt = clean[i].intersection(clean[k]).representative_point()
-                raise ArenaError(
-                    f"regions {i} and {k} overlap or touch (near x={pt.x:.6g}, y={pt.y:.6g}); "
-                    "disjoint regions must be separated",
-                    file=source,
-                )
+        clean.append(orient(Polygon(shell, [h.exterior for h in holes]), 1.0))
+    for i, k in _touching_pairs(clean):
+        pt = clean[i].intersection(clean[k]).representative_point()
+        raise ArenaError(
+            f"regions {i} and {k} overlap or touch (near x={pt.x:.6g}, y={pt.y:.6g}); "
+            "disjoint regions must be separated",
+            file=source,
+        )
     return MultiPolygon(clean)
 
 
-def _check_ring(ring: LinearRing, where: str, source) -> None:
-    coords = np.asarray(ring.coords)
-    if len(coords) < 4:
-        raise ArenaError(f"{where} has fewer than 3 distinct corners", file=source)
+def _touching_pairs(polys: list[Polygon]):
+    """Index pairs (j < k) of polygons that intersect, in order (STRtree: no k^2 tests)."""
+    if len(polys) < 2:
+        return []
+    left, right = shapely.STRtree(polys).query(polys, predicate="intersects")
+    keep = left < right
+    return sorted(zip(left[keep].tolist(), right[keep].tolist()))
+
+
+def _clean_ring(ring: LinearRing, where: str, source) -> LinearRing:
+    """The ring in 2-D without repeated consecutive vertices; must be simple."""
+    coords = np.asarray(ring.coords, dtype=np.float64)
+    if coords.ndim != 2:  # an empty ring
+        coords = coords.reshape(0, 2)
     if not np.all(np.isfinite(coords)):
         raise ArenaError(f"{where} has a non-finite coordinate", file=source)
-    if not ring.is_simple:
-        bad = shapely.validation.explain_validity(Polygon(ring))
+    xy = coords[:, :2]
+    if len(xy):
+        xy = xy[np.r_[True, np.any(np.diff(xy, axis=0) != 0, axis=1)]]
+    if len(xy) < 4:
+        raise ArenaError(f"{where} has fewer than 3 distinct corners", file=source)
+    clean = LinearRing(xy)
+    if not clean.is_simple:
+        bad = shapely.validation.explain_validity(Polygon(clean))
         raise ArenaError(f"{where} crosses itself ({bad})", file=source)
+    return clean

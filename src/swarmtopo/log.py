@@ -20,6 +20,8 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
+import pyarrow as pa
+import pyarrow.compute as pc
 
 from .errors import InputError
 
@@ -77,7 +79,9 @@ class EncounterLog:
         Parameters
         ----------
         t, a, b
-            Event columns in file order (IDs as int or str).
+            Event columns in file order (IDs as int or str).  Columns may be
+            sequences, numpy arrays or pyarrow arrays (text IDs and states are then
+            dictionary-encoded in C: no per-row Python work for 10^6 rows).
         status
             ``(t, agent, state)`` columns, state as strings RW / WF / S (or None).
         static
@@ -99,51 +103,58 @@ class EncounterLog:
         meta = dict(meta or {})
         src_e = source["events"]
         t = _times(t, src_e, "t")
-        a_raw, b_raw = _ids(a, src_e, "a"), _ids(b, src_e, "b")
-        if not (len(t) == len(a_raw) == len(b_raw)):
+        ev_a, ev_b = _factorize_ids(a, src_e, "a"), _factorize_ids(b, src_e, "b")
+        if not (len(t) == len(ev_a.index) == len(ev_b.index)):
             raise InputError("columns t, a, b have different lengths", file=src_e)
         if status is not None:
             st_t = _times(status[0], source["status"], "t")
-            st_agent = _ids(status[1], source["status"], "agent")
+            st_agent = _factorize_ids(status[1], source["status"], "agent")
             st_state = _states(status[2], source["status"])
         else:
-            st_t, st_agent, st_state = np.empty(0), _ids([], "", ""), np.empty(0, np.int8)
+            st_t, st_agent, st_state = np.empty(0), _IdColumn.empty("", ""), np.empty(0, np.int8)
         if static is not None:
-            sa = _ids(static[0], source["static"], "agent")
+            static_ids = _factorize_ids(static[0], source["static"], "agent")
             stime = _times(static[1], source["static"], "time")
         else:
-            sa, stime = _ids([], "", ""), np.empty(0)
+            static_ids, stime = _IdColumn.empty("", ""), np.empty(0)
 
+        id_cols = [ev_a, ev_b, st_agent, static_ids]
         declared = _declared_ids(meta)
-        kinds = {arr.dtype.kind for arr in (a_raw, b_raw, st_agent, sa) if len(arr)}
+        kinds = {c.labels.dtype.kind for c in id_cols if len(c.index)}
         if declared is not None and len(declared):
             kinds.add(declared.dtype.kind)
-        as_text = "O" in kinds or "U" in kinds
-        cols = [_as_kind(x, as_text) for x in (a_raw, b_raw, st_agent, sa)]
+        as_text = "U" in kinds
+        id_cols = [c.as_text() if as_text else c for c in id_cols]
         if declared is not None:
             declared = _as_kind(declared, as_text)
-            for arr, name, col in ((cols[0], src_e, "a"), (cols[1], src_e, "b"),
-                                   (cols[2], source["status"], "agent"), (cols[3], source["static"], "agent")):
-                bad = ~np.isin(arr, declared)
+            for col in id_cols:
+                bad = ~np.isin(col.labels, declared)[col.index]
                 if bad.any():
                     i = int(np.argmax(bad))
                     raise InputError("agent ID is not among the agents the metadata declares",
-                                     file=name, row=i + 1, column=col, value=arr[i])
+                                     file=col.src, row=i + 1, column=col.column, value=col.value(i))
             agent_ids = np.unique(declared)
         else:
-            agent_ids = np.unique(np.concatenate(cols)) if any(len(c) for c in cols) else cols[0][:0]
-        codes = [np.searchsorted(agent_ids, c).astype(np.int64) for c in cols]
-        ca, cb, cst, csa = codes
+            agent_ids = np.unique(np.concatenate([c.labels for c in id_cols]))
+        ca, cb, cst, csa = (np.searchsorted(agent_ids, c.labels).astype(np.int64)[c.index] for c in id_cols)
+        if agent_ids.dtype.kind == "U":
+            agent_ids = agent_ids.astype(object)  # text IDs are stored as Python str
 
         self_pair = ca == cb
         if self_pair.any():
             i = int(np.argmax(self_pair))
             raise InputError("an agent cannot encounter itself (a == b)", file=src_e, row=i + 1,
-                             column="b", value=b_raw[i])
+                             column="b", value=id_cols[1].value(i))
         lo, hi = np.minimum(ca, cb), np.maximum(ca, cb)
-        order = np.lexsort((hi, lo, t))
-        t, lo, hi = t[order], lo[order], hi[order]
-        dup = (np.diff(t) == 0) & (np.diff(lo) == 0) & (np.diff(hi) == 0)
+        pair = lo * max(len(agent_ids), 1) + hi  # orders like (lo, hi)
+        dt, dpair = np.diff(t), np.diff(pair)
+        if np.all((dt > 0) | ((dt == 0) & (dpair >= 0))):  # already sorted: the usual file
+            order = np.arange(len(t))
+        else:
+            order = np.lexsort((pair, t))
+            t, lo, hi, pair = t[order], lo[order], hi[order], pair[order]
+            dt, dpair = np.diff(t), np.diff(pair)
+        dup = (dt == 0) & (dpair == 0)
         if dup.any():
             k = int(np.argmax(dup))
             r1, r2 = sorted((int(order[k]) + 1, int(order[k + 1]) + 1))
@@ -155,7 +166,7 @@ class EncounterLog:
             _, first = np.unique(csa, return_index=True)
             i = int(np.setdiff1d(np.arange(len(csa)), first)[0])
             raise InputError("agent listed as static twice", file=source["static"], row=i + 1,
-                             column="agent", value=sa[i])
+                             column="agent", value=id_cols[3].value(i))
         sa_order = np.argsort(csa, kind="stable")
         meta.setdefault("agent_count", int(len(agent_ids)))
         return cls(
@@ -199,15 +210,12 @@ class EncounterLog:
         is_stop = st == S
         nxt_same = np.r_[ag[1:] == ag[:-1], False]
         end = np.where(nxt_same, np.r_[t[1:], np.inf], np.inf)
-        # consecutive S rows of one agent belong to one stop: keep the first, extend its end
-        starts = is_stop & ~(np.r_[False, nxt_same[:-1]] & np.r_[False, is_stop[:-1]])
-        idx = np.flatnonzero(starts)
-        ends = np.empty(len(idx))
-        for n, i in enumerate(idx):
-            j = i
-            while nxt_same[j] and st[j + 1] == S:
-                j += 1
-            ends[n] = end[j]
+        # consecutive S rows of one agent form one stop: from its first row to the
+        # change after its last row
+        prev_stop = np.r_[False, nxt_same[:-1] & is_stop[:-1]]
+        next_stop = nxt_same & np.r_[is_stop[1:], False]
+        idx = np.flatnonzero(is_stop & ~prev_stop)
+        ends = end[is_stop & ~next_stop]
         return ag[idx], t[idx], ends
 
     def ids_of(self, codes) -> np.ndarray:
@@ -220,17 +228,27 @@ class EncounterLog:
 
 
 # -- column validation ---------------------------------------------------------------
+# ID and state columns are factorized (distinct labels + an integer index per row), so
+# the per-row work on 10^6 rows is integer numpy work; only distinct labels are Python.
 def _times(values, src, col) -> np.ndarray:
     arr = np.asarray(values)
     if arr.dtype.kind in "biuf":
         out = arr.astype(np.float64)
     else:
-        out = np.empty(len(arr))
-        for i, v in enumerate(arr):
-            try:
-                out[i] = float(v)
-            except (TypeError, ValueError):
-                raise InputError("time is not a number", file=src, row=i + 1, column=col, value=v) from None
+        if arr.dtype.kind == "O":  # numpy would read None as NaN
+            missing = np.fromiter((v is None for v in arr), dtype=bool, count=len(arr))
+            if missing.any():
+                i = int(np.argmax(missing))
+                raise InputError("time is missing", file=src, row=i + 1, column=col)
+        try:
+            out = arr.astype(np.float64)
+        except (TypeError, ValueError):  # convert one by one to locate the bad value
+            out = np.empty(len(arr))
+            for i, v in enumerate(arr):
+                try:
+                    out[i] = float(v)
+                except (TypeError, ValueError):
+                    raise InputError("time is not a number", file=src, row=i + 1, column=col, value=v) from None
     bad = ~np.isfinite(out)
     if bad.any():
         i = int(np.argmax(bad))
@@ -242,42 +260,123 @@ def _times(values, src, col) -> np.ndarray:
     return out
 
 
-def _ids(values, src, col) -> np.ndarray:
+@dataclass(frozen=True)
+class _IdColumn:
+    """One column of agent IDs, factorized: row ``i`` holds ``labels[index[i]]``.
+
+    ``labels`` are the distinct IDs (int64, or a numpy 'U' array of text); all per-row
+    work on the column is integer work on ``index``.
+    """
+
+    labels: np.ndarray
+    index: np.ndarray
+    src: str
+    column: str
+
+    @classmethod
+    def empty(cls, src, column) -> "_IdColumn":
+        return cls(np.empty(0, np.int64), np.empty(0, np.int64), src, column)
+
+    def value(self, row: int):
+        return self.labels[self.index[row]]
+
+    def as_text(self) -> "_IdColumn":
+        return replace(self, labels=_as_kind(self.labels, True))
+
+
+def _factorize_ids(values, src, col) -> _IdColumn:
+    """Validate a column of IDs (ints, text, or a pyarrow array) and factorize it."""
+    if isinstance(values, (pa.Array, pa.ChunkedArray)):
+        values = _arrow_ids(values, src, col)
+        if isinstance(values, _IdColumn):
+            return values
     arr = np.asarray(values)
+    if len(arr) == 0:
+        return _IdColumn.empty(src, col)
     if arr.dtype.kind == "f":
         bad = ~np.isfinite(arr) | (arr != np.round(arr))
         if bad.any():
             i = int(np.argmax(bad))
             raise InputError("agent ID must be an integer or a text label", file=src, row=i + 1,
                              column=col, value=arr[i])
-        return arr.astype(np.int64)
-    if arr.dtype.kind in "iub":
-        return arr.astype(np.int64)
+        arr = arr.astype(np.int64)
+    elif arr.dtype.kind in "iub":
+        arr = arr.astype(np.int64)
+    else:
+        if arr.dtype.kind == "O":
+            missing = np.fromiter((v is None or (isinstance(v, float) and not np.isfinite(v)) for v in arr),
+                                  dtype=bool, count=len(arr))
+            if missing.any():
+                i = int(np.argmax(missing))
+                raise InputError("agent ID is missing", file=src, row=i + 1, column=col, value=arr[i])
+        arr = arr.astype(str)
+    labels, index = np.unique(arr, return_inverse=True)
+    return _checked_text(_IdColumn(labels, index.reshape(-1).astype(np.int64), src, col))
+
+
+def _arrow_ids(arr, src, col):
+    """pyarrow column -> numpy numbers, or a factorized text column (no per-row Python)."""
+    if isinstance(arr, pa.ChunkedArray):
+        arr = arr.combine_chunks()
     if len(arr) == 0:
         return np.empty(0, np.int64)
-    out = arr.astype(object)
-    for i, v in enumerate(out):
-        if v is None or (isinstance(v, float) and not np.isfinite(v)) or (isinstance(v, str) and not v.strip()):
-            raise InputError("agent ID is missing", file=src, row=i + 1, column=col, value=v)
-    return np.array([str(v) for v in out], dtype=object)
+    if arr.null_count:
+        i = int(np.argmax(arr.is_null().to_numpy(zero_copy_only=False)))
+        raise InputError("agent ID is missing", file=src, row=i + 1, column=col)
+    if pa.types.is_dictionary(arr.type):
+        arr = arr.dictionary_decode()
+    if pa.types.is_integer(arr.type) or pa.types.is_floating(arr.type) or pa.types.is_boolean(arr.type):
+        return arr.to_numpy(zero_copy_only=False)
+    try:
+        arr = arr.cast(pa.string())
+    except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
+        raise InputError(f"agent ID must be an integer or a text label, not {arr.type}", file=src,
+                         column=col, value=arr[0].as_py()) from None
+    enc = pc.dictionary_encode(arr)
+    labels = np.asarray(enc.dictionary.to_pylist(), dtype=str).reshape(-1)
+    order = np.argsort(labels)
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    index = rank[enc.indices.to_numpy(zero_copy_only=False).astype(np.int64)]
+    return _checked_text(_IdColumn(labels[order], index, src, col))
+
+
+def _checked_text(ids: _IdColumn) -> _IdColumn:
+    if ids.labels.dtype.kind == "U":
+        blank = np.strings.str_len(np.strings.strip(ids.labels)) == 0
+        if blank.any():
+            i = int(np.argmax(blank[ids.index]))
+            raise InputError("agent ID is missing", file=ids.src, row=i + 1, column=ids.column,
+                             value=ids.value(i))
+    return ids
 
 
 def _states(values, src) -> np.ndarray:
-    arr = np.asarray(values).astype(object)
+    """State strings (RW / WF / S, any case, surrounding blanks ignored) -> int8 codes."""
+    if isinstance(values, (pa.Array, pa.ChunkedArray)):
+        if isinstance(values, pa.ChunkedArray):
+            values = values.combine_chunks()
+        enc = pc.dictionary_encode(values)
+        labels = np.array(enc.dictionary.to_pylist() + [None], dtype=object)
+        index = enc.indices.fill_null(len(labels) - 1).to_numpy(zero_copy_only=False)
+    else:
+        labels, index = np.unique(np.asarray(values).astype(str), return_inverse=True)
+        labels = labels.astype(object)
     lookup = {s: k for k, s in enumerate(STATES)}
-    out = np.empty(len(arr), np.int8)
-    for i, v in enumerate(arr):
-        code = lookup.get(str(v).strip().upper() if v is not None else None)
-        if code is None:
-            raise InputError(f"unknown state; expected one of {', '.join(STATES)}", file=src,
-                             row=i + 1, column="state", value=v)
-        out[i] = code
+    label_codes = np.array([lookup.get(str(v).strip().upper() if v is not None else None, -1)
+                            for v in labels], dtype=np.int8)
+    out = label_codes[np.asarray(index).reshape(-1)] if len(labels) else np.empty(0, np.int8)
+    bad = out < 0
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise InputError(f"unknown state; expected one of {', '.join(STATES)}", file=src,
+                         row=i + 1, column="state", value=labels[index[i]])
     return out
 
 
 def _declared_ids(meta) -> np.ndarray | None:
     if meta.get("agent_ids") is not None:
-        return _ids(list(meta["agent_ids"]), "meta.json", "agent_ids")
+        return _factorize_ids(list(meta["agent_ids"]), "meta.json", "agent_ids").labels
     if meta.get("agent_count") is not None:
         n = meta["agent_count"]
         if not isinstance(n, int) or n < 0:
@@ -288,6 +387,6 @@ def _declared_ids(meta) -> np.ndarray | None:
 
 
 def _as_kind(arr: np.ndarray, as_text: bool) -> np.ndarray:
-    if as_text and arr.dtype.kind != "O":
-        return np.array([str(v) for v in arr], dtype=object)
+    if as_text and arr.dtype.kind != "U":
+        return arr.astype(str)
     return arr

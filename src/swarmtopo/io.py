@@ -1,0 +1,586 @@
+"""Files in and out: log folders, arenas (GeoJSON) and JSON.
+
+The log folder is the contract between whoever records a deployment (the simulator,
+a real base station, someone's script) and ``swarmtopo map``.  A folder ``DIR`` holds
+
+=====================  ===================================  ==========================
+file                   columns / keys                       status
+=====================  ===================================  ==========================
+``events.<fmt>``       ``t, a, b``                          required
+``status.<fmt>``       ``t, agent, state`` (RW, WF, S)      optional
+``meta.json``          parameters, ``static`` =             optional
+                       ``[{"agent": id, "time": t}, ...]``,
+                       units, seed, version, ``agent_count``
+                       or ``agent_ids``; ``simulation``
+                       (simulator-only ground truth)
+``arena.geojson``      the true arena                       optional, ground truth
+``truth.<fmt>``        ``t, a, b, xa, ya, xb, yb``, one     optional, ground truth
+                       row per event in the events' order
+``trajectories.<fmt>`` ``t, agent, x, y[, state]``          optional, ground truth
+=====================  ===================================  ==========================
+
+``fmt`` is ``csv`` or ``parquet`` (one of them per file name).  Times are in seconds,
+positions in millimetres.  Agent IDs are integers or text: in a CSV file an ID column
+is integer only if every ID in the folder is written as a plain integer (``7``, not
+``007`` or ``7.0``) and ``meta.json`` does not declare text ``agent_ids``; otherwise all
+IDs are text, so ``"007"`` stays ``"007"``.  Extra columns are ignored by
+:func:`read_log` and kept by :func:`read_truth` / :func:`read_trajectories`.
+
+CSV and Parquet go through pyarrow (multi-threaded C++ readers) and ID columns are
+dictionary-encoded, never turned into Python objects row by row: 10^6 events read in
+about a second from CSV and half a second from Parquet.  Every error a file can cause is an :class:`~.errors.InputError`
+naming the file, the 1-based data row, the column and the value.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.compute as pc
+import pyarrow.csv as pcsv
+import pyarrow.parquet as pq
+
+from .arena import Arena
+from .errors import InputError, SwarmtopoError
+from .log import STATES, EncounterLog, _states  # _states: the one parser of state labels
+
+FORMATS: tuple[str, ...] = ("csv", "parquet")
+EVENT_COLUMNS = ("t", "a", "b")
+STATUS_COLUMNS = ("t", "agent", "state")
+TRUTH_COLUMNS = ("t", "a", "b", "xa", "ya", "xb", "yb")
+TRAJECTORY_COLUMNS = ("t", "agent", "x", "y")
+GROUND_TRUTH_FILES = ("arena.geojson", *(f"{stem}.{fmt}" for stem in ("truth", "trajectories") for fmt in FORMATS))
+"""Files that only a simulator can write; ``swarmtopo map`` never reads them."""
+
+_TABLE_STEMS = ("events", "status", "truth", "trajectories")
+_PLAIN_INTEGER = r"^-?(0|[1-9][0-9]*)$"
+
+
+# -- log folders -------------------------------------------------------------------------
+def write_log(
+    log: EncounterLog,
+    directory,
+    *,
+    fmt: str = "csv",
+    truth: dict | None = None,
+    trajectories: dict | None = None,
+    arena: Arena | None = None,
+) -> list[Path]:
+    """Write a log folder (see the module docstring); returns the paths written.
+
+    The folder is created if needed.  Its contract files that this call does not write
+    (``truth.*`` from an earlier run, ``events.parquet`` when writing CSV, ...) are
+    deleted, so the folder always describes exactly this log; other files are left
+    alone.  Identical inputs give byte-identical files: ``meta.json`` has sorted keys
+    and no timestamps, floats are written in their shortest exact form.
+
+    Parameters
+    ----------
+    log
+        The log.  Events are written in canonical order, status changes sorted by
+        (t, agent), agent IDs in their original type.  ``meta.json`` holds ``log.meta``
+        plus ``static`` (a list of ``{"agent", "time"}``), ``agent_count`` and, unless
+        the IDs are exactly ``0 .. n-1``, ``agent_ids``.
+    fmt
+        ``"csv"`` or ``"parquet"``.
+    truth
+        Ground truth per event, aligned with ``log``'s events: arrays ``xa, ya, xb,
+        yb`` (positions of agents ``log.a``, ``log.b`` in mm) and any extra columns.
+        ``t, a, b`` are written from the log; if given they must match it.
+    trajectories
+        Ground-truth positions: arrays ``t, agent, x, y`` and optionally ``state``
+        (strings or codes into STATES) and extra columns.
+    arena
+        The true arena, written as ``arena.geojson``.
+    """
+    if fmt not in FORMATS:
+        raise SwarmtopoError(f"unknown log format {fmt!r}; expected one of {', '.join(FORMATS)}")
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    ids_a, ids_b = log.ids_of(log.a), log.ids_of(log.b)
+    tables = {"events": {"t": log.t, "a": ids_a, "b": ids_b}}
+    if len(log.status_t):
+        order = np.lexsort((log.status_agent, log.status_t))
+        tables["status"] = {
+            "t": log.status_t[order],
+            "agent": log.ids_of(log.status_agent[order]),
+            "state": np.asarray(STATES, dtype=object)[log.status_state[order]],
+        }
+    if truth is not None:
+        tables["truth"] = _truth_columns(log, truth, ids_a, ids_b)
+    if trajectories is not None:
+        tables["trajectories"] = _trajectory_columns(trajectories)
+
+    written = [_write_table(columns, directory / f"{stem}.{fmt}") for stem, columns in tables.items()]
+    written.append(write_json(_meta_for(log), directory / "meta.json"))
+    if arena is not None:
+        written.append(write_arena(arena, directory / "arena.geojson"))
+    keep = {p.name for p in written}
+    stale = [f"{stem}.{f}" for stem in _TABLE_STEMS for f in FORMATS] + ["meta.json", "arena.geojson"]
+    for name in stale:
+        if name not in keep and (directory / name).is_file():
+            (directory / name).unlink()
+    return written
+
+
+def read_log(directory) -> EncounterLog:
+    """Read a log folder: ``events.<fmt>`` is required, everything else optional.
+
+    Only ``events``, ``status`` and ``meta.json`` are read -- never ground truth.
+    ``meta["static"]`` becomes the log's static agents; the rest of ``meta.json`` is
+    ``log.meta``.  Unsorted events are sorted.
+
+    Raises
+    ------
+    InputError
+        Naming the file, the 1-based data row, the column and the value: missing
+        file or column, unparsable CSV, non-numeric / NaN / negative / missing times,
+        missing IDs, a == b, unknown states, IDs outside ``agent_ids`` /
+        ``agent_count``, duplicate events, malformed ``meta.json``; or when both
+        ``events.csv`` and ``events.parquet`` exist.
+    """
+    directory = _log_dir(directory)
+    meta_path = directory / "meta.json"
+    meta = _read_meta(meta_path)
+    events_path = _find_table(directory, "events", required=True)
+    status_path = _find_table(directory, "status")
+    events = _read_table(events_path, EVENT_COLUMNS)
+    status = _read_table(status_path, STATUS_COLUMNS) if status_path else None
+
+    id_cols = [(events[c], events_path, c) for c in ("a", "b")]
+    if status is not None:
+        id_cols.append((status["agent"], status_path, "agent"))
+    ids = _id_arrays(id_cols, declared_text=_declares_text_ids(meta))
+    t = _number_column(events["t"], events_path, "t", "time")
+    status_cols = None
+    if status is not None:
+        status_cols = (_number_column(status["t"], status_path, "t", "time"), ids[2], status["state"])
+    static = meta.pop("static", None)
+    static_cols = None
+    if static is not None:
+        static_cols = ([entry["agent"] for entry in static], [entry["time"] for entry in static])
+    return EncounterLog.from_records(
+        t, ids[0], ids[1], status=status_cols, static=static_cols, meta=meta,
+        source={"events": str(events_path), "status": str(status_path), "static": f"{meta_path} static"},
+    )
+
+
+def read_truth(directory) -> dict[str, np.ndarray] | None:
+    """Ground truth per event (``truth.<fmt>``) as numpy arrays, or None if absent.
+
+    Keys ``t, a, b, xa, ya, xb, yb`` (float64 times and positions, IDs as in the log)
+    plus any extra columns of the file.
+    """
+    directory = _log_dir(directory)
+    path = _find_table(directory, "truth")
+    if path is None:
+        return None
+    table = _read_table(path, TRUTH_COLUMNS, keep_all=True)
+    declared_text = _declares_text_ids(_read_meta(directory / "meta.json"))
+    a, b = _id_arrays([(table["a"], path, "a"), (table["b"], path, "b")], declared_text=declared_text)
+    out = {"t": _number_column(table["t"], path, "t", "time"), "a": _id_numpy(a), "b": _id_numpy(b)}
+    for col in ("xa", "ya", "xb", "yb"):
+        out[col] = _number_column(table[col], path, col, "position")
+    out.update(_extra_columns(table, out))
+    return out
+
+
+def read_trajectories(directory) -> dict[str, np.ndarray] | None:
+    """Ground-truth trajectories (``trajectories.<fmt>``) as numpy arrays, or None.
+
+    Keys ``t, x, y`` (float64), ``agent`` (IDs as in the log), ``state`` (int8 codes
+    into STATES) when the file has it, plus any extra columns.
+    """
+    directory = _log_dir(directory)
+    path = _find_table(directory, "trajectories")
+    if path is None:
+        return None
+    table = _read_table(path, TRAJECTORY_COLUMNS, keep_all=True)
+    declared_text = _declares_text_ids(_read_meta(directory / "meta.json"))
+    (agent,) = _id_arrays([(table["agent"], path, "agent")], declared_text=declared_text)
+    out = {"t": _number_column(table["t"], path, "t", "time"), "agent": _id_numpy(agent)}
+    for col in ("x", "y"):
+        out[col] = _number_column(table[col], path, col, "position")
+    if "state" in table:
+        out["state"] = _states(table["state"], str(path))
+    out.update(_extra_columns(table, out))
+    return out
+
+
+def strip_ground_truth(src_dir, dst_dir) -> None:
+    """Copy a log folder without its ground truth.
+
+    ``dst_dir`` gets ``events.*``, ``status.*`` and ``meta.json`` without its
+    ``simulation`` key -- no ``arena.geojson``, ``truth.*``, ``trajectories.*`` and no
+    file outside the contract.  Used to prove that ``swarmtopo map`` needs nothing else.
+    ``dst_dir`` must not exist yet or be empty.
+    """
+    src, dst = _log_dir(src_dir), Path(dst_dir)
+    if dst.exists() and (not dst.is_dir() or any(dst.iterdir())):
+        raise InputError("destination must be a new or empty folder", file=str(dst))
+    dst.mkdir(parents=True, exist_ok=True)
+    for stem in ("events", "status"):
+        path = _find_table(src, stem, required=stem == "events")
+        if path is not None:
+            shutil.copyfile(path, dst / path.name)
+    if (src / "meta.json").is_file():
+        meta = read_json(src / "meta.json")
+        if isinstance(meta, dict):
+            meta.pop("simulation", None)
+        write_json(meta, dst / "meta.json")
+
+
+# -- arenas and JSON -----------------------------------------------------------------------
+def read_arena(path) -> Arena:
+    """Read an arena from a GeoJSON file (Polygon, MultiPolygon, Feature or FeatureCollection)."""
+    return Arena.from_geojson(read_json(path), source=str(path))
+
+
+def write_arena(arena: Arena, path) -> Path:
+    """Write an arena as a GeoJSON Feature; returns the path."""
+    return write_json(arena.to_geojson(), path)
+
+
+def read_json(path) -> Any:
+    """Parse a JSON file; errors name the file and the line and column of a syntax error."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise InputError("file not found", file=str(path)) from None
+    except UnicodeDecodeError as exc:
+        raise InputError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=str(path)) from None
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise InputError(f"invalid JSON: {exc.msg} (line {exc.lineno}, column {exc.colno})", file=str(path)) from None
+
+
+def write_json(obj, path) -> Path:
+    """Write JSON with sorted keys and 2-space indent (byte-stable); returns the path.
+
+    numpy scalars and arrays are written as plain numbers and lists; NaN and
+    infinities are refused (they are not JSON).
+    """
+    path = Path(path)
+    try:
+        text = json.dumps(obj, sort_keys=True, indent=2, allow_nan=False, default=_json_default)
+    except ValueError as exc:
+        raise InputError(f"cannot write JSON: {exc}", file=str(path)) from None
+    _atomic_write(path, lambda tmp: tmp.write_text(text + "\n", encoding="utf-8"))
+    return path
+
+
+# -- writing helpers -----------------------------------------------------------------------
+def _meta_for(log: EncounterLog) -> dict:
+    meta = dict(log.meta)
+    meta["static"] = [{"agent": _json_id(a), "time": float(t)}
+                      for a, t in zip(log.ids_of(log.static_agent), log.static_time)]
+    meta["agent_count"] = log.n_agents
+    ids = log.agent_ids
+    plain = ids.dtype.kind == "i" and np.array_equal(ids, np.arange(len(ids)))
+    if not plain or "agent_ids" in meta:
+        meta["agent_ids"] = [_json_id(v) for v in ids]
+    return meta
+
+
+def _truth_columns(log: EncounterLog, truth: dict, ids_a, ids_b) -> dict:
+    missing = [c for c in TRUTH_COLUMNS[3:] if c not in truth]
+    if missing:
+        raise ValueError(f"truth lacks column(s) {', '.join(missing)}")
+    n = log.n_events
+    for name, values in truth.items():
+        if len(values) != n:
+            raise ValueError(f"truth[{name!r}] has {len(values)} rows; the log has {n} events")
+    if "t" in truth and not np.array_equal(np.asarray(truth["t"], float), log.t):
+        raise ValueError("truth['t'] is not aligned with the log's events (canonical order)")
+    for name, codes, ids in (("a", log.a, ids_a), ("b", log.b, ids_b)):
+        if name in truth:
+            given = np.asarray(truth[name])
+            if not (np.array_equal(given, codes) or np.array_equal(given, ids)):
+                raise ValueError(f"truth[{name!r}] is not aligned with the log's events (canonical order)")
+    columns = {"t": log.t, "a": ids_a, "b": ids_b}
+    columns.update({k: v for k, v in truth.items() if k not in columns})
+    return columns
+
+
+def _trajectory_columns(trajectories: dict) -> dict:
+    missing = [c for c in TRAJECTORY_COLUMNS if c not in trajectories]
+    if missing:
+        raise ValueError(f"trajectories lack column(s) {', '.join(missing)}")
+    columns = dict(trajectories)
+    if "state" in columns:
+        state = np.asarray(columns["state"])
+        if state.dtype.kind in "iu":
+            columns["state"] = np.asarray(STATES, dtype=object)[state]
+    return columns
+
+
+def _write_table(columns: dict, path: Path) -> Path:
+    table = pa.table({name: _arrow_column(values) for name, values in columns.items()})
+    if path.suffix == ".csv":
+        _atomic_write(path, lambda tmp: pcsv.write_csv(table, tmp))
+    else:
+        _atomic_write(path, lambda tmp: pq.write_table(table, tmp))
+    return path
+
+
+def _arrow_column(values) -> pa.Array:
+    arr = np.asarray(values)
+    if arr.dtype.kind in "OU":
+        return pa.array(arr.astype(object), type=pa.string())
+    return pa.array(arr)
+
+
+def _atomic_write(path: Path, write) -> None:
+    """Write through a temporary file in the same folder, then rename over ``path``."""
+    tmp = path.with_name(f".{path.name}.tmp")
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
+def _json_id(value):
+    return int(value) if isinstance(value, (int, np.integer)) else str(value)
+
+
+def _json_default(obj):
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, np.floating):
+        return float(obj)
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, Path):
+        return str(obj)
+    raise TypeError(f"object of type {type(obj).__name__} is not JSON serializable")
+
+
+# -- reading helpers -----------------------------------------------------------------------
+def _log_dir(directory) -> Path:
+    directory = Path(directory)
+    if not directory.is_dir():
+        raise InputError("log folder not found", file=str(directory))
+    return directory
+
+
+def _find_table(directory: Path, stem: str, *, required: bool = False) -> Path | None:
+    found = [directory / f"{stem}.{fmt}" for fmt in FORMATS if (directory / f"{stem}.{fmt}").is_file()]
+    if len(found) > 1:
+        raise InputError(f"both {found[0].name} and {found[1].name} exist; keep one", file=str(directory))
+    if not found:
+        if required:
+            raise InputError(f"no {stem}.csv or {stem}.parquet in the log folder", file=str(directory))
+        return None
+    return found[0]
+
+
+def _read_table(path: Path, required: tuple[str, ...], *, keep_all: bool = False) -> dict[str, pa.Array]:
+    """Columns of a CSV / Parquet file by (stripped) name.
+
+    CSV: the ``required`` columns are read as text (so IDs keep leading zeros and a bad
+    time can be located), trimmed of surrounding blanks; other columns are inferred.
+    Only ``required`` columns (plus ``state``) are read unless ``keep_all``.
+    """
+    if path.suffix == ".csv":
+        names = _csv_header(path)
+    else:
+        try:
+            names = pq.read_schema(path).names
+        except (pa.ArrowException, OSError) as exc:
+            raise InputError(f"cannot read Parquet file ({exc})", file=str(path)) from None
+    by_name = {}
+    for raw in names:
+        if raw.strip() in by_name:
+            raise InputError("column appears twice", file=str(path), column=raw.strip())
+        by_name[raw.strip()] = raw
+    missing = [c for c in required if c not in by_name]
+    if missing:
+        raise InputError(f"missing column '{missing[0]}'; found columns: {', '.join(map(repr, by_name)) or 'none'}",
+                         file=str(path), column=missing[0])
+    text = [c for c in dict.fromkeys((*required, "state")) if c in by_name]
+    wanted = list(by_name) if keep_all else text
+    if path.suffix == ".csv":
+        table = _read_csv(path, [by_name[c] for c in wanted], {by_name[c] for c in text})
+    else:
+        try:
+            table = pq.read_table(path, columns=[by_name[c] for c in wanted])
+        except (pa.ArrowException, OSError) as exc:
+            raise InputError(f"cannot read Parquet file ({exc})", file=str(path)) from None
+    out = {}
+    for name in wanted:
+        col = table.column(by_name[name]).combine_chunks()
+        if pa.types.is_dictionary(col.type):
+            col = col.dictionary_decode()
+        if path.suffix == ".csv" and name in text:
+            col = pc.utf8_trim_whitespace(col)
+        out[name] = col
+    return out
+
+
+def _csv_header(path: Path) -> list[str]:
+    try:
+        with pcsv.open_csv(path, read_options=pcsv.ReadOptions(block_size=1 << 16)) as reader:
+            return reader.schema.names
+    except pa.ArrowInvalid as exc:
+        raise InputError(_csv_problem(path, exc), file=str(path)) from None
+    except OSError as exc:
+        raise InputError(f"cannot read file ({exc})", file=str(path)) from None
+
+
+def _read_csv(path: Path, columns: list[str], text: set[str]) -> pa.Table:
+    convert = pcsv.ConvertOptions(include_columns=columns, column_types={c: pa.string() for c in text},
+                                  strings_can_be_null=False)
+    try:
+        return pcsv.read_csv(path, convert_options=convert)
+    except pa.ArrowInvalid as exc:
+        raise InputError(_csv_problem(path, exc), file=str(path)) from None
+
+
+def _csv_problem(path: Path, exc: Exception) -> str:
+    """pyarrow's parse error, with the 1-based data row found by a single-threaded re-read."""
+    bad = []
+
+    def record(row):
+        bad.append(row)
+        return "error"
+
+    try:
+        pcsv.read_csv(path, read_options=pcsv.ReadOptions(use_threads=False),
+                      parse_options=pcsv.ParseOptions(invalid_row_handler=record))
+    except pa.ArrowInvalid:
+        pass
+    reason = str(exc).removeprefix("CSV parse error: ")
+    if bad and bad[0].number is not None:  # number counts the header as row 1
+        return f"row {bad[0].number - 1}: cannot parse CSV ({reason})"
+    return f"cannot parse CSV ({reason})"
+
+
+def _number_column(col: pa.Array, path: Path, name: str, what: str) -> np.ndarray:
+    """float64 column; text is parsed, and the first bad value is located exactly."""
+    kind = col.type
+    if pa.types.is_string(kind) or pa.types.is_large_string(kind):
+        try:
+            col = pc.cast(col, pa.float64())
+        except pa.ArrowInvalid:
+            i = _first_uncastable(col, pa.float64())
+            value = col[i].as_py()
+            problem = f"{what} is missing" if value == "" else f"{what} is not a number"
+            raise InputError(problem, file=str(path), row=i + 1, column=name, value=value) from None
+    elif pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_decimal(kind):
+        col = pc.cast(col, pa.float64())
+    elif pa.types.is_null(kind) and len(col) == 0:
+        col = pa.array([], pa.float64())
+    else:
+        raise InputError(f"{what} must be a number, not {kind}", file=str(path), row=1, column=name,
+                         value=col[0].as_py() if len(col) else None)
+    if col.null_count:
+        i = int(np.argmax(col.is_null().to_numpy(zero_copy_only=False)))
+        raise InputError(f"{what} is missing", file=str(path), row=i + 1, column=name)
+    return col.to_numpy(zero_copy_only=False)
+
+
+def _first_uncastable(col: pa.Array, to_type) -> int:
+    """Index of the first value that does not cast; bisection, so O(n) vectorised work."""
+    lo, hi = 0, len(col)  # invariant: the first bad value lies in col[lo:hi]
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        try:
+            pc.cast(col.slice(lo, mid - lo), to_type)
+        except pa.ArrowInvalid:
+            hi = mid
+        else:
+            lo = mid
+    return lo
+
+
+def _id_arrays(columns: list[tuple[pa.Array, Path, str]], *, declared_text: bool) -> list:
+    """Give all ID columns of a folder one kind: int64 numpy arrays, or pyarrow text.
+
+    Integer if every column is integer-typed (floats are left to the log's integrality
+    check) or, in CSV, holds only plain integers, and meta declares no text IDs.  Text
+    columns of a Parquet file are text whatever they hold.
+    """
+    for col, path, name in columns:
+        if col.null_count:
+            i = int(np.argmax(col.is_null().to_numpy(zero_copy_only=False)))
+            raise InputError("agent ID is missing", file=str(path), row=i + 1, column=name)
+
+    def integer_like(col: pa.Array, path: Path) -> bool:
+        if pa.types.is_integer(col.type) or pa.types.is_floating(col.type):
+            return True
+        if path.suffix == ".csv":  # CSV has no types: every ID column was read as text
+            return pc.all(pc.match_substring_regex(col, _PLAIN_INTEGER)).as_py() is not False
+        return False
+
+    as_int = not declared_text and all(integer_like(col, path) for col, path, _ in columns)
+    out = []
+    for col, _, _ in columns:
+        if as_int and not pa.types.is_floating(col.type):
+            try:
+                col = pc.cast(col, pa.int64())
+            except pa.ArrowInvalid:  # a plain integer beyond int64: treat every ID as text
+                return _id_arrays(columns, declared_text=True)
+        elif not as_int:
+            col = pc.cast(col, pa.string())
+        out.append(col.to_numpy(zero_copy_only=False) if as_int else col)
+    return out
+
+
+def _id_numpy(ids) -> np.ndarray:
+    """IDs as numpy: int64, or an object array of str."""
+    if isinstance(ids, np.ndarray):
+        return ids.astype(np.int64) if ids.dtype.kind == "f" else ids
+    return ids.to_numpy(zero_copy_only=False).astype(object)
+
+
+def _extra_columns(table: dict[str, pa.Array], known: dict) -> dict[str, np.ndarray]:
+    return {name: col.to_numpy(zero_copy_only=False) for name, col in table.items() if name not in known}
+
+
+def _read_meta(path: Path) -> dict:
+    """meta.json as a dict ({} if absent), with ``static`` and the ID keys checked."""
+    if not path.is_file():
+        return {}
+    meta = read_json(path)
+    if not isinstance(meta, dict):
+        raise InputError(f"meta.json must hold a JSON object, not {type(meta).__name__}", file=str(path))
+    static = meta.get("static")
+    if static is not None:
+        if not isinstance(static, list):
+            raise InputError("key 'static' must be a list of {\"agent\": id, \"time\": t}", file=str(path),
+                             value=static)
+        for i, entry in enumerate(static):
+            if not (isinstance(entry, dict) and "agent" in entry and "time" in entry):
+                raise InputError(f"key 'static': entry {i + 1} must be an object with 'agent' and 'time'",
+                                 file=str(path), value=entry)
+    count = meta.get("agent_count")
+    if count is not None and (isinstance(count, bool) or not isinstance(count, int) or count < 0):
+        raise InputError("key 'agent_count' must be a non-negative integer", file=str(path), value=count)
+    ids = meta.get("agent_ids")
+    if ids is not None:
+        if not isinstance(ids, list):
+            raise InputError("key 'agent_ids' must be a list of IDs", file=str(path), value=ids)
+        for i, v in enumerate(ids):
+            if isinstance(v, bool) or not isinstance(v, (int, str)) or (isinstance(v, str) and not v.strip()):
+                raise InputError(f"key 'agent_ids': entry {i + 1} must be an integer or a non-empty text",
+                                 file=str(path), value=v)
+        if count is not None and count != len(ids):
+            raise InputError(f"key 'agent_count' is {count} but 'agent_ids' lists {len(ids)} agents",
+                             file=str(path), value=count)
+    return meta
+
+
+def _declares_text_ids(meta: dict) -> bool:
+    return any(isinstance(v, str) for v in meta.get("agent_ids") or [])

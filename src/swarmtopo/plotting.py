@@ -1,0 +1,133 @@
+"""Matplotlib figures.  Every function takes ``ax=None`` and returns the Axes; none
+calls ``plt.show()`` or changes global style.  matplotlib is imported here only."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .persistence import Diagram
+
+_DIM_COLORS = {0: "tab:blue", 1: "tab:red", 2: "tab:green"}
+
+
+def _axes(ax, projection=None):
+    if ax is not None:
+        return ax
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(5, 5))
+    return fig.add_subplot(projection=projection)
+
+
+def plot_diagram(diagram: Diagram, ax=None, *, thresholds: dict[int, float] | None = None, title=None):
+    """Persistence diagram: births against deaths per dimension, infinite deaths on a
+    dashed line at the top; optional significance threshold per dimension drawn as a
+    line parallel to the diagonal (death = birth + threshold)."""
+    ax = _axes(ax)
+    finite = [diagram[n][np.isfinite(diagram[n][:, 1])] for n in range(diagram.maxdim + 1)]
+    values = np.concatenate([f.ravel() for f in finite] + [diagram[0][:, 0]])
+    top = float(values.max()) if values.size else 1.0
+    top = top * 1.1 if top > 0 else 1.0
+    for n in range(diagram.maxdim + 1):
+        pts = diagram[n]
+        inf = ~np.isfinite(pts[:, 1])
+        color = _DIM_COLORS.get(n, "k")
+        ax.scatter(pts[~inf, 0], pts[~inf, 1], s=12, color=color, label=f"H{n} ({len(pts)})", alpha=0.8)
+        if inf.any():
+            ax.scatter(pts[inf, 0], np.full(inf.sum(), top), s=30, marker="^", color=color)
+        if thresholds and n in thresholds:
+            tau = thresholds[n]
+            ax.plot([0, top], [tau, top + tau], ls=":", color=color, lw=1, label=f"H{n} threshold")
+    ax.plot([0, top], [0, top], color="0.5", lw=1)
+    ax.axhline(top, ls="--", color="0.7", lw=0.8)
+    ax.set_xlim(-0.02 * top, top * 1.02)
+    ax.set_ylim(-0.02 * top, top * 1.05)
+    ax.set_xlabel("birth (s)")
+    ax.set_ylabel("death (s)")
+    ax.legend(loc="lower right", fontsize=8)
+    ax.set_title(title or "persistence diagram")
+    return ax
+
+
+def plot_barcode(diagram: Diagram, ax=None, *, dims=(0, 1), thresholds: dict[int, float] | None = None,
+                 max_bars: int = 60, title=None):
+    """Barcode: the ``max_bars`` longest bars of each dimension, longest on top;
+    infinite bars run to the right edge with an arrow.  With ``thresholds``, bars
+    longer than their dimension's threshold are drawn solid, the others faded."""
+    ax = _axes(ax)
+    dims = [n for n in dims if n <= diagram.maxdim]
+    finite_deaths = np.concatenate([diagram[n][np.isfinite(diagram[n][:, 1]), 1] for n in dims] + [[1.0]])
+    right = float(finite_deaths.max()) * 1.1
+    y = 0
+    for n in dims:
+        bars = diagram[n][:max_bars]
+        color = _DIM_COLORS.get(n, "k")
+        limit = thresholds.get(n) if thresholds else None
+        for birth, death in bars[::-1]:
+            end = death if np.isfinite(death) else right
+            faded = limit is not None and death - birth <= limit
+            ax.plot([birth, end], [y, y], color=color, lw=2, solid_capstyle="butt", alpha=0.3 if faded else 1.0)
+            if not np.isfinite(death):
+                ax.annotate("", xy=(right, y), xytext=(right * 0.97, y), arrowprops=dict(arrowstyle="->", color=color))
+            y += 1
+        label = f"H{n}" + (f" (solid: longer than {limit:.3g})" if limit is not None else "")
+        ax.text(right, y - 0.5, label, ha="right", va="top", color=color, fontsize=8)
+        y += 2
+    ax.set_yticks([])
+    ax.set_xlabel("filtration scale (s)")
+    ax.set_title(title or "barcode")
+    return ax
+
+
+def plot_point_cloud(coords: np.ndarray, color, ax=None, *, cmap="viridis", label=None, title=None):
+    """MDS encounter point cloud (2-D or 3-D coords), coloured by ``color``: an array
+    of values (colour map, with colour bar) or an (n, 3) RGB array."""
+    dim = coords.shape[1]
+    ax = _axes(ax, projection="3d" if dim == 3 else None)
+    color = np.asarray(color)
+    rgb = color.ndim == 2
+    kwargs = dict(c=color, s=10, depthshade=False) if dim == 3 else dict(c=color, s=10)
+    if not rgb:
+        kwargs["cmap"] = cmap
+    sc = ax.scatter(*coords.T, **kwargs)
+    if not rgb and label:
+        ax.figure.colorbar(sc, ax=ax, shrink=0.6, label=label)
+    ax.set_title(title or "encounter point cloud (MDS)")
+    return ax
+
+
+def plot_arena(arena, ax=None, *, points: np.ndarray | None = None, color=None, title=None):
+    """The arena (free space grey, walls black) with optional points at true positions."""
+    ax = _axes(ax)
+    for region in arena.regions:
+        x, y = region.exterior.xy
+        ax.fill(x, y, color="0.93", zorder=0)
+        ax.plot(x, y, color="k", lw=1.5)
+        for ring in region.interiors:
+            x, y = ring.xy
+            ax.fill(x, y, color="0.45", zorder=1)
+            ax.plot(x, y, color="k", lw=1.5)
+    if points is not None and len(points):
+        ax.scatter(points[:, 0], points[:, 1], c=color, s=8, zorder=2)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.set_title(title or "arena (ground truth)")
+    return ax
+
+
+def position_colors(xy: np.ndarray, bounds) -> np.ndarray:
+    """RGB colours encoding a true position: red grows with x, blue with y."""
+    xmin, ymin, xmax, ymax = bounds
+    u = np.clip((xy[:, 0] - xmin) / max(xmax - xmin, 1e-12), 0, 1)
+    v = np.clip((xy[:, 1] - ymin) / max(ymax - ymin, 1e-12), 0, 1)
+    return np.column_stack([0.15 + 0.8 * u, 0.35 + 0.3 * (1 - np.abs(u - v)), 0.15 + 0.8 * v])
+
+
+def new_figure(width: float, height: float):
+    """A Figure not attached to pyplot's global state (safe in threads and workers)."""
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=(width, height), layout="constrained")
+
+

@@ -1,0 +1,74 @@
+"""What ``swarmtopo map`` and ``swarmtopo demo`` write: map.json and PNG figures.
+
+Ground truth (true positions, the arena) only colours pictures here; it never
+reaches :func:`swarmtopo.pipeline.map_encounters`.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from .log import EncounterLog
+from .pipeline import TopologicalMap
+
+
+def write_map_outputs(tmap: TopologicalMap, out_dir: Path, *, log: EncounterLog,
+                      truth: dict[str, np.ndarray] | None = None, arena=None) -> list[Path]:
+    """Write map.json, diagram.png and (with an MDS picture) cloud.png; return the paths."""
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = [out_dir / "map.json", out_dir / "diagram.png"]
+    written[0].write_text(json.dumps(tmap.to_json(), indent=2, allow_nan=False) + "\n")
+    _diagram_figure(tmap).savefig(written[1], dpi=110)
+    if any(r.embedding is not None for r in tmap.regions):
+        written.append(out_dir / "cloud.png")
+        _cloud_figure(tmap, log, truth, arena).savefig(written[2], dpi=110)
+    return written
+
+
+def _diagram_figure(tmap: TopologicalMap):
+    from .plotting import new_figure, plot_barcode, plot_diagram
+
+    rows = len(tmap.regions)
+    fig = new_figure(10, 4.5 * rows)
+    axes = fig.subplots(rows, 2, squeeze=False)
+    for (ax_d, ax_b), region, thr in zip(axes, tmap.regions, tmap.thresholds["regions"]):
+        lengths = {int(n): v for n, v in thr["length"].items()}
+        name = f"region {region.component}: " if rows > 1 else ""
+        betti = ", ".join(f"beta_{n}={b}" for n, b in sorted(region.betti.items()))
+        plot_diagram(region.diagram, ax_d, thresholds=lengths, title=f"{name}persistence diagram ({betti})")
+        plot_barcode(region.diagram, ax_b, thresholds=lengths, title=f"{name}barcode")
+    return fig
+
+
+def _cloud_figure(tmap: TopologicalMap, log: EncounterLog, truth, arena):
+    from .plotting import new_figure, plot_arena, plot_point_cloud, position_colors
+
+    with_truth = truth is not None
+    rows = len(tmap.regions)
+    cols = 3 if with_truth and arena is not None else (2 if with_truth else 1)
+    fig = new_figure(5.2 * cols, 4.8 * rows)
+    dim = tmap.config.embed_dim
+    for r, region in enumerate(tmap.regions):
+        if region.embedding is None:
+            continue
+        coords = region.embedding.coords
+        events = region.landmark_events
+        ax = fig.add_subplot(rows, cols, r * cols + 1, projection="3d" if dim == 3 else None)
+        plot_point_cloud(coords, log.t[events], ax, label="event time (s)",
+                         title=f"landmarks in encounter space (stress {region.embedding.stress:.2f})")
+        if not with_truth:
+            continue
+        xy = np.column_stack([(truth["xa"][events] + truth["xb"][events]) / 2,
+                              (truth["ya"][events] + truth["yb"][events]) / 2])
+        bounds = arena.bounds if arena is not None else (*xy.min(axis=0), *xy.max(axis=0))
+        colors = position_colors(xy, bounds)
+        ax = fig.add_subplot(rows, cols, r * cols + 2, projection="3d" if dim == 3 else None)
+        plot_point_cloud(coords, colors, ax, title="coloured by true position")
+        if arena is not None:
+            plot_arena(arena, fig.add_subplot(rows, cols, r * cols + 3), points=xy, color=colors,
+                       title="landmark events at true positions")
+    return fig

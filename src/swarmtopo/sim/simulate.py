@@ -1,0 +1,305 @@
+"""Simulate a swarm in an arena and record what a base station would receive.
+
+Time steps t_k = k dt (rounded to 9 decimals), k = 0 .. K, K = round(duration / dt).
+At each step:
+
+1. sense at positions p_k: contacts that start now become events [t_k, a, b];
+2. apply the commands with time <= t_k not yet applied, then decide each agent's
+   state transitions at t_k (status rows get time t_k);
+3. move every agent to p_{k+1} (not after the last step).
+
+Agents start uniformly at random in the free space (``arena.sample_uniform``), in
+state RW, with a random heading.  The status log has a row at t = 0 for every agent
+(its state after the decisions at t = 0, so an agent born within r_d of a wall starts
+as WF) and then a row whenever its state changes.  Every random draw comes from the
+one ``np.random.Generator`` made from ``rng``: the same seed gives byte-identical
+logs, and the pure-Python kernels (:func:`interpreted_kernels`) give the same run.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numba.core.registry import CPUDispatcher
+
+from ..arena import Arena
+from ..errors import InputError
+from ..log import STATES, EncounterLog
+from . import commands as _commands
+from . import motion as _motion
+from . import sensing as _sensing
+from . import walls as _walls
+from .params import STATIC, Command, MotionParams, SensingParams
+
+TIME_DECIMALS = 9
+
+
+@dataclass
+class Simulation:
+    """Result of :func:`simulate`.
+
+    Attributes
+    ----------
+    log : EncounterLog
+        What the base station receives (agent IDs 0 .. N-1).
+    truth : dict of str to ndarray or None
+        Ground truth per event, same order as ``log.t / log.a / log.b``: keys ``t, a,
+        b, xa, ya, xb, yb`` (``xa, ya`` = position of agent ``log.a``, mm).
+    trajectories : dict of str to ndarray or None
+        Samples every ``trajectory_every`` s (a multiple of dt, from t = 0): keys ``t,
+        agent, x, y, state`` (int8 code of STATES), ordered by (t, agent).  ``state`` is
+        the state decided at t, which governs the move from t to t + dt.
+    arena : Arena
+        The arena simulated.
+    """
+
+    log: EncounterLog
+    truth: dict[str, np.ndarray] | None
+    trajectories: dict[str, np.ndarray] | None
+    arena: Arena
+
+
+def simulate(
+    arena: Arena,
+    n_agents: int = 200,
+    duration: float = 20.0,
+    *,
+    dt: float = 0.1,
+    motion: MotionParams = MotionParams(),
+    sensing: SensingParams = SensingParams(),
+    commands: Sequence[Command] = (),
+    static_fraction: float = 0.0,
+    static_time: float = 0.0,
+    rng=None,
+    truth: bool = False,
+    trajectory_every: float | None = None,
+    progress: Callable[[float], None] | None = None,
+) -> Simulation:
+    """Run the bio-inspired swarm model in ``arena`` and log encounters and status changes.
+
+    Parameters
+    ----------
+    arena : Arena
+        Free space (mm).
+    n_agents : int
+        Swarm size N >= 1.
+    duration : float
+        Simulated time, s (K = round(duration / dt) steps).
+    dt : float
+        Time step, s; must satisfy max(v_c, v_p) dt <= r_d / 4.
+    motion, sensing : MotionParams, SensingParams
+        Model parameters (paper defaults: v_c, l*, v_p, tau_stop, p_sh, tau_s, tau_l,
+        tau_exit; r_d).
+    commands : sequence of Command
+        Base-station commands, applied in time order (ties: given order).
+    static_fraction, static_time : float
+        Shortcut for ``Command(static_time, "static", fraction=static_fraction)``.
+    rng : int, Generator or None
+        Randomness; an int seed is recorded in ``log.meta["seed"]``.
+    truth : bool
+        Also return the true positions of every event.
+    trajectory_every : float or None
+        Also return positions and states sampled this often (s, rounded to a multiple
+        of dt, at least dt).
+    progress : callable or None
+        Called with the fraction done (about 100 times).
+
+    Returns
+    -------
+    Simulation
+    """
+    _check_inputs(arena, n_agents, duration, dt, motion, sensing, commands, static_fraction, static_time,
+                  trajectory_every, progress)
+    commands = list(commands)
+    if static_fraction > 0:
+        commands.append(Command(static_time, "static", fraction=static_fraction))
+    commands.sort(key=lambda c: c.time)
+    seed = int(rng) if isinstance(rng, (int, np.integer)) and not isinstance(rng, bool) else None
+    try:
+        gen = np.random.default_rng(rng)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"rng must be an int seed, a numpy Generator or None ({exc})", value=rng) from None
+
+    n = int(n_agents)
+    n_steps = int(round(duration / dt))
+    r_d = sensing.r_d
+    max_step = max(motion.v_c, motion.v_p) * dt
+    walls = _walls.build_wall_grid(arena.boundary_segments, arena.bounds, cell=r_d, reach=r_d + 3 * max_step)
+    model = _motion.make_model(motion, r_d, dt)
+    agents = _motion.new_swarm(arena.sample_uniform(n, gen, clearance=_walls.WALL_EPS), model, gen)
+    tracker = _sensing.EncounterTracker(n, r_d, walls if sensing.walls_block else None,
+                                        log_initial_contacts=sensing.log_initial_contacts)
+    sample_every = None if trajectory_every is None else max(1, int(round(trajectory_every / dt)))
+    report_every = max(1, (n_steps + 1) // 100)
+
+    events: list[tuple] = []
+    status: list[tuple] = []
+    static_agents: list[np.ndarray] = []
+    static_times: list[np.ndarray] = []
+    samples: list[tuple] = []
+    changed = np.empty(n, np.int64)
+    next_command = 0
+    for k in range(n_steps + 1):
+        t = round(k * dt, TIME_DECIMALS)
+        x, y = np.ascontiguousarray(agents["x"]), np.ascontiguousarray(agents["y"])
+        a, b = tracker.update(t, x, y)
+        if len(a):
+            events.append((t, a, b, x[a], y[a], x[b], y[b]))
+        while next_command < len(commands) and round(commands[next_command].time, TIME_DECIMALS) <= t:
+            cmd = commands[next_command]
+            targets = _commands.resolve_agents(cmd, n, gen)
+            if cmd.mode == STATIC:
+                newly = targets[agents["mode"][targets] != STATIC]
+                static_agents.append(newly)
+                static_times.append(np.full(len(newly), t))
+            _commands.apply_command(agents, model, walls, gen, targets, np.int8(cmd.mode))
+            next_command += 1
+        n_changed = _motion.step_swarm(agents, model, walls, gen, k < n_steps, changed)
+        if n_changed:
+            who = changed[:n_changed].copy()
+            status.append((t, who, agents["state"][who]))
+        if sample_every is not None and k % sample_every == 0:
+            samples.append((t, x, y, agents["state"].copy()))
+        if progress is not None and (k % report_every == 0 or k == n_steps):
+            progress((k + 1) / (n_steps + 1))
+
+    meta = _meta(arena, n, n_steps, dt, motion, sensing, commands, static_fraction, static_time, seed)
+    log, order = _build_log(events, status, static_agents, static_times, meta)
+    return Simulation(
+        log=log,
+        truth=_truth(events, order) if truth else None,
+        trajectories=_trajectories(samples, n) if sample_every is not None else None,
+        arena=arena,
+    )
+
+
+def _check_inputs(arena, n_agents, duration, dt, motion, sensing, commands, static_fraction, static_time,
+                  trajectory_every, progress) -> None:
+    if not isinstance(arena, Arena):
+        raise InputError(f"arena must be a swarmtopo Arena, got {type(arena).__name__}")
+    if isinstance(n_agents, bool) or not isinstance(n_agents, (int, np.integer)) or n_agents < 1:
+        raise InputError("n_agents must be an integer >= 1", value=n_agents)
+    if not isinstance(motion, MotionParams):
+        raise InputError(f"motion must be a MotionParams, got {type(motion).__name__}")
+    if not isinstance(sensing, SensingParams):
+        raise InputError(f"sensing must be a SensingParams, got {type(sensing).__name__}")
+    for name, value in (("dt", dt), ("duration", duration), ("static_time", static_time)):
+        if not isinstance(value, (int, float, np.integer, np.floating)) or not math.isfinite(value):
+            raise InputError(f"{name} must be a finite number of seconds", value=value)
+    if dt <= 0:
+        raise InputError("dt must be > 0 s", value=dt)
+    if duration < 0 or static_time < 0:
+        raise InputError("duration and static_time must be >= 0 s", value=min(duration, static_time))
+    speed = max(motion.v_c, motion.v_p)
+    if speed * dt > sensing.r_d / 4:
+        raise InputError(
+            f"time step too coarse: agents move max(v_c, v_p) * dt = {speed * dt:g} mm per step, more than "
+            f"r_d / 4 = {sensing.r_d / 4:g} mm, so contacts and walls could be stepped over; "
+            f"use dt <= {sensing.r_d / (4 * speed):g} s", value=dt)
+    if not isinstance(static_fraction, (int, float, np.integer, np.floating)) or not 0 <= static_fraction <= 1:
+        raise InputError("static_fraction must be in [0, 1]", value=static_fraction)
+    for c in commands:
+        if not isinstance(c, Command):
+            raise InputError(f"commands must be Command objects, got {type(c).__name__}", value=c)
+    _commands.check_command_agents(commands, int(n_agents))
+    if trajectory_every is not None and not (isinstance(trajectory_every, (int, float, np.integer, np.floating))
+                                             and trajectory_every > 0 and math.isfinite(trajectory_every)):
+        raise InputError("trajectory_every must be a positive number of seconds or None", value=trajectory_every)
+    if progress is not None and not callable(progress):
+        raise InputError("progress must be callable or None", value=progress)
+
+
+def _jsonable(value):
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
+    return value
+
+
+def _meta(arena, n, n_steps, dt, motion, sensing, commands, static_fraction, static_time, seed) -> dict:
+    provenance = {
+        "n_agents": n,
+        "motion": {k: _jsonable(v) for k, v in dataclasses.asdict(motion).items()},
+        "sensing": dataclasses.asdict(sensing),
+        "commands": [{"time": c.time, "behaviour": c.behaviour, "fraction": c.fraction,
+                      "agents": None if c.agents is None else list(c.agents)} for c in commands],
+        "static_fraction": float(static_fraction),
+        "static_time": float(static_time),
+        "arena_betti": list(arena.betti),
+    }
+    return {
+        "units": {"time": "s", "length": "mm"},
+        "r_d": sensing.r_d,
+        "v_c": motion.v_c,
+        "v_p": motion.v_p,
+        "duration": round(n_steps * dt, TIME_DECIMALS),
+        "dt": float(dt),
+        "agent_count": n,
+        "seed": seed,
+        "simulation": provenance,
+    }
+
+
+def _build_log(events, status, static_agents, static_times, meta):
+    if events:
+        t = np.concatenate([np.full(len(e[1]), e[0]) for e in events])
+        a = np.concatenate([e[1] for e in events])
+        b = np.concatenate([e[2] for e in events])
+    else:
+        t, a, b = np.empty(0), np.empty(0, np.int64), np.empty(0, np.int64)
+    st_t = np.concatenate([np.full(len(s[1]), s[0]) for s in status])
+    st_agent = np.concatenate([s[1] for s in status])
+    st_state = np.asarray(STATES, dtype=object)[np.concatenate([s[2] for s in status])]
+    static = None
+    if static_agents:
+        static = (np.concatenate(static_agents), np.concatenate(static_times))
+    log = EncounterLog.from_records(t, a, b, status=(st_t, st_agent, st_state), static=static, meta=meta)
+    order = np.lexsort((b, a, t))
+    return log, order
+
+
+def _truth(events, order) -> dict[str, np.ndarray]:
+    keys = ("t", "a", "b", "xa", "ya", "xb", "yb")
+    if not events:
+        return {k: np.empty(0, np.int64 if k in ("a", "b") else np.float64) for k in keys}
+    cols = {"t": np.concatenate([np.full(len(e[1]), e[0]) for e in events])}
+    for j, k in enumerate(keys[1:], start=1):
+        cols[k] = np.concatenate([e[j] for e in events])
+    return {k: v[order] for k, v in cols.items()}
+
+
+def _trajectories(samples, n) -> dict[str, np.ndarray]:
+    return {
+        "t": np.repeat(np.array([s[0] for s in samples]), n),
+        "agent": np.tile(np.arange(n, dtype=np.int64), len(samples)),
+        "x": np.concatenate([s[1] for s in samples]),
+        "y": np.concatenate([s[2] for s in samples]),
+        "state": np.concatenate([s[3] for s in samples]).astype(np.int8),
+    }
+
+
+@contextlib.contextmanager
+def interpreted_kernels():
+    """Run the simulator on the kernels' pure-Python ``.py_func`` (tests, benchmarks).
+
+    Inside the block every numba kernel of ``swarmtopo.sim`` is replaced by its
+    Python source function, so a simulation is a plain per-agent Python loop of the
+    same model with the same neighbour search.  Not thread-safe.
+    """
+    modules = [_walls, _motion, _commands, _sensing]
+    saved = []
+    for module in modules:
+        for name, obj in vars(module).items():
+            if isinstance(obj, CPUDispatcher):
+                saved.append((module, name, obj))
+    try:
+        for module, name, obj in saved:
+            setattr(module, name, obj.py_func)
+        yield
+    finally:
+        for module, name, obj in saved:
+            setattr(module, name, obj)

@@ -1,0 +1,176 @@
+"""Wall geometry for the simulator: a bucketed list of boundary segments and its queries.
+
+Every boundary edge of the arena (outer walls and obstacle walls alike) is a segment
+``[x0, y0, x1, y1]``.  A :class:`WallGrid` lays a uniform grid of square cells (side
+about r_d) over the arena's bounding box and lists, per cell, every segment within
+``reach`` of the cell *rectangle* (an exact shapely ``dwithin`` query, so no cell
+diagonal needs adding).  For any point inside a cell, every segment closer than
+``reach`` is therefore listed, and a query costs O(segments nearby), not O(all).
+The simulator picks ``reach`` = r_d + 3 max(v_c, v_p) dt, which covers every query it
+makes: wall detection (r_d), the wall-follow re-projection (<= offset + 2 steps),
+moves (<= one step) and lines of sight between agents in contact (<= r_d).
+
+No orientation of the rings is used: the side of the free space is always the side of
+the querying agent, which is never on a wall (every accepted position keeps a
+clearance > ``WALL_EPS`` from all segments).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+import shapely
+from numba import njit
+
+agent_kernel = njit(cache=True, _nrt=False)
+"""Decorator of the per-agent helpers (geometry here, the state machine in motion).
+
+They are compiled without numba's reference-counting runtime (``_nrt=False``, the
+option numba uses for its own allocation-free helpers): they neither allocate nor
+return arrays, and with the runtime every call would update the reference counts of
+each array argument and of the Generator -- atomic operations that cost more than
+the helpers' own work (measured: 8x on an empty call).  Their ``.py_func`` is plain
+Python, as for any njit function."""
+
+WALL_EPS = 1e-6
+"""Minimum clearance (mm) of an agent from any wall; moves ending closer are rejected."""
+
+
+class WallGrid(NamedTuple):
+    """Boundary segments bucketed by grid cell (CSR: ``index[start[c]:start[c+1]]``)."""
+
+    segs: np.ndarray   # (M, 4) float64 [x0, y0, x1, y1]
+    start: np.ndarray  # (ncx * ncy + 1,) int64, cell c = cy * ncx + cx
+    index: np.ndarray  # int64 segment ids
+    x0: float
+    y0: float
+    cell: float
+    ncx: int
+    ncy: int
+
+
+def build_wall_grid(segments: np.ndarray, bounds, cell: float, reach: float) -> WallGrid:
+    """Bucket ``segments`` over ``bounds`` = (xmin, ymin, xmax, ymax) in cells of side ``cell``.
+
+    A segment is listed in a cell when its distance to the cell rectangle is <= ``reach``.
+    """
+    segs = np.array(segments, dtype=np.float64, order="C").reshape(-1, 4)  # writable: one kernel type
+    xmin, ymin, xmax, ymax = (float(v) for v in bounds)
+    ncx = max(1, math.ceil((xmax - xmin) / cell))
+    ncy = max(1, math.ceil((ymax - ymin) / cell))
+    cy, cx = np.divmod(np.arange(ncx * ncy), ncx)
+    boxes = shapely.box(xmin + cx * cell, ymin + cy * cell, xmin + (cx + 1) * cell, ymin + (cy + 1) * cell)
+    if len(segs):
+        tree = shapely.STRtree(shapely.linestrings(segs.reshape(-1, 2, 2)))
+        cell_id, seg_id = tree.query(boxes, predicate="dwithin", distance=reach)
+        order = np.lexsort((seg_id, cell_id))
+        cell_id, seg_id = cell_id[order], seg_id[order]
+    else:
+        cell_id = seg_id = np.empty(0, np.int64)
+    start = np.zeros(ncx * ncy + 1, np.int64)
+    np.cumsum(np.bincount(cell_id, minlength=ncx * ncy), out=start[1:])
+    return WallGrid(segs, start, seg_id.astype(np.int64), xmin, ymin, float(cell), ncx, ncy)
+
+
+def empty_wall_grid() -> WallGrid:
+    """A grid without walls (for sensing without an arena)."""
+    return WallGrid(np.empty((0, 4)), np.zeros(2, np.int64), np.empty(0, np.int64), 0.0, 0.0, 1.0, 1, 1)
+
+
+@agent_kernel
+def cell_of(walls, x, y):
+    """Grid cell holding (x, y); points outside the grid go to the nearest edge cell."""
+    cx = min(max(int((x - walls.x0) / walls.cell), 0), walls.ncx - 1)
+    cy = min(max(int((y - walls.y0) / walls.cell), 0), walls.ncy - 1)
+    return cy * walls.ncx + cx
+
+
+@agent_kernel
+def nearest_wall(walls, x, y):
+    """Nearest boundary point to (x, y) among listed segments.
+
+    Returns (distance, qx, qy, segment id); (inf, nan, nan, -1) if no wall is within reach.
+    """
+    c = cell_of(walls, x, y)
+    best, bx, by, bk = np.inf, np.nan, np.nan, -1
+    for j in range(walls.start[c], walls.start[c + 1]):
+        k = walls.index[j]
+        x0, y0, x1, y1 = walls.segs[k, 0], walls.segs[k, 1], walls.segs[k, 2], walls.segs[k, 3]
+        dx, dy = x1 - x0, y1 - y0
+        u = ((x - x0) * dx + (y - y0) * dy) / (dx * dx + dy * dy)
+        u = min(max(u, 0.0), 1.0)
+        qx, qy = x0 + u * dx, y0 + u * dy
+        d = math.sqrt((x - qx) * (x - qx) + (y - qy) * (y - qy))
+        if d < best:
+            best, bx, by, bk = d, qx, qy, k
+    return best, bx, by, bk
+
+
+@agent_kernel
+def _orient(ax, ay, bx, by, cx, cy):
+    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+
+
+@agent_kernel
+def _within_box(ax, ay, bx, by, px, py):
+    return min(ax, bx) <= px <= max(ax, bx) and min(ay, by) <= py <= max(ay, by)
+
+
+@agent_kernel
+def segments_intersect(ax, ay, bx, by, cx, cy, dx, dy):
+    """True if the closed segments a-b and c-d share a point (touching counts)."""
+    d1 = _orient(cx, cy, dx, dy, ax, ay)
+    d2 = _orient(cx, cy, dx, dy, bx, by)
+    d3 = _orient(ax, ay, bx, by, cx, cy)
+    d4 = _orient(ax, ay, bx, by, dx, dy)
+    if ((d1 > 0 and d2 < 0) or (d1 < 0 and d2 > 0)) and ((d3 > 0 and d4 < 0) or (d3 < 0 and d4 > 0)):
+        return True
+    return ((d1 == 0 and _within_box(cx, cy, dx, dy, ax, ay))
+            or (d2 == 0 and _within_box(cx, cy, dx, dy, bx, by))
+            or (d3 == 0 and _within_box(ax, ay, bx, by, cx, cy))
+            or (d4 == 0 and _within_box(ax, ay, bx, by, dx, dy)))
+
+
+@agent_kernel
+def line_of_sight(walls, ax, ay, bx, by):
+    """True if the segment a-b crosses no wall listed near a (|a - b| <= reach)."""
+    c = cell_of(walls, ax, ay)
+    for j in range(walls.start[c], walls.start[c + 1]):
+        k = walls.index[j]
+        if segments_intersect(ax, ay, bx, by, walls.segs[k, 0], walls.segs[k, 1],
+                              walls.segs[k, 2], walls.segs[k, 3]):
+            return False
+    return True
+
+
+@agent_kernel
+def path_is_clear(walls, px, py, ex, ey):
+    """A move p -> e is allowed: it crosses no wall and ends farther than WALL_EPS from all."""
+    if not line_of_sight(walls, px, py, ex, ey):
+        return False
+    return nearest_wall(walls, ex, ey)[0] > WALL_EPS
+
+
+@agent_kernel
+def first_hit(walls, px, py, ex, ey):
+    """First wall met on the move p -> e: (u, segment id), u in [0, 1] along the move.
+
+    Returns (inf, -1) if the move meets no wall.  Collinear contact counts as u = 0.
+    """
+    c = cell_of(walls, px, py)
+    best_u, best_k = np.inf, -1
+    rx, ry = ex - px, ey - py
+    for j in range(walls.start[c], walls.start[c + 1]):
+        k = walls.index[j]
+        x0, y0, x1, y1 = walls.segs[k, 0], walls.segs[k, 1], walls.segs[k, 2], walls.segs[k, 3]
+        if not segments_intersect(px, py, ex, ey, x0, y0, x1, y1):
+            continue
+        sx, sy = x1 - x0, y1 - y0
+        denom = rx * sy - ry * sx
+        u = ((x0 - px) * sy - (y0 - py) * sx) / denom if denom != 0 else 0.0
+        u = min(max(u, 0.0), 1.0)
+        if u < best_u:
+            best_u, best_k = u, k
+    return best_u, best_k

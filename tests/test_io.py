@@ -1,0 +1,435 @@
+"""Log folders on disk: round trips, byte stability, located errors, ground-truth stripping."""
+
+import json
+import time
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.csv as pcsv
+import pyarrow.parquet as pq
+import pytest
+
+from swarmtopo.arena import default_arena
+from swarmtopo.errors import InputError, SwarmtopoError
+from swarmtopo.io import (
+    GROUND_TRUTH_FILES,
+    read_arena,
+    read_json,
+    read_log,
+    read_trajectories,
+    read_truth,
+    strip_ground_truth,
+    write_json,
+    write_log,
+)
+from swarmtopo.log import STATES, EncounterLog
+
+FORMATS = ["csv", "parquet"]
+AWKWARD_TIMES = [0.1, 1 / 3, 1e-300, 123456789.12345679, 5e-324, 2.0, 1e22, 0.30000000000000004]
+
+
+def make_log(ids="int", status=True, static=True, meta=None):
+    rng = np.random.default_rng(1)
+    n_agents = 6
+    t = np.array(AWKWARD_TIMES + list(np.round(rng.uniform(0, 50, 30), 3)))
+    a = rng.integers(0, n_agents, len(t))
+    b = (a + rng.integers(1, n_agents, len(t))) % n_agents
+    labels = {"int": np.array([0, 1, 2, 3, 4, 5]), "sparse": np.array([3, 17, 42, 99, 1000, 7]),
+              "text": np.array(["007", "a,b", 'say "hi"', "x", "é", "10"], dtype=object),
+              "digits": np.array(["1", "2", "3", "4", "5", "6"], dtype=object)}[ids]
+    kwargs = {"meta": dict(meta or {"r_d": 30.0, "seed": 5, "units": {"t": "s", "x": "mm"}})}
+    if status:
+        kwargs["status"] = (np.array([0.0, 0.0, 1.5, 2.0, 1 / 3]), labels[[0, 1, 0, 2, 1]],
+                            np.array(["RW", "WF", "S", "S", "RW"], dtype=object))
+    if static:
+        kwargs["static"] = (labels[[4, 2]], np.array([10.0, 12.25]))
+    return EncounterLog.from_records(t, labels[a], labels[b], **kwargs)
+
+
+def assert_same_log(x: EncounterLog, y: EncounterLog):
+    for name in ("t", "a", "b", "agent_ids", "status_t", "status_agent", "status_state", "static_agent",
+                 "static_time"):
+        u, v = getattr(x, name), getattr(y, name)
+        assert u.dtype.kind == v.dtype.kind, name
+        assert np.array_equal(u, v), name
+    assert [type(v) for v in x.agent_ids] == [type(v) for v in y.agent_ids]
+
+
+# -- round trips -------------------------------------------------------------------------
+@pytest.mark.parametrize("fmt", FORMATS)
+@pytest.mark.parametrize("ids", ["int", "sparse", "text", "digits"])
+@pytest.mark.parametrize("extras", [(True, True), (False, False), (True, False)])
+def test_round_trip(tmp_path, fmt, ids, extras):
+    log = make_log(ids, *extras)
+    write_log(log, tmp_path, fmt=fmt)
+    back = read_log(tmp_path)
+    assert_same_log(log, back)
+    expected_meta = dict(log.meta)
+    if ids != "int":  # IDs other than 0..n-1 are declared explicitly
+        expected_meta["agent_ids"] = log.agent_ids.tolist()
+    assert back.meta == expected_meta
+    # a second trip changes nothing
+    write_log(back, tmp_path / "again", fmt=fmt)
+    assert read_log(tmp_path / "again").meta == back.meta
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_times_round_trip_bit_exactly(tmp_path, fmt):
+    log = make_log()
+    write_log(log, tmp_path, fmt=fmt)
+    back = read_log(tmp_path)
+    assert back.t.view(np.int64).tolist() == log.t.view(np.int64).tolist()
+    assert set(AWKWARD_TIMES) <= set(back.t.tolist())
+
+
+def test_only_events_is_a_valid_log(tmp_path):
+    (tmp_path / "events.csv").write_text("t,a,b\n0.5,1,2\n0.25,2,3\n")
+    log = read_log(tmp_path)
+    assert log.t.tolist() == [0.25, 0.5] and log.agent_ids.tolist() == [1, 2, 3]
+    assert len(log.status_t) == 0 and len(log.static_agent) == 0
+    assert log.meta == {"agent_count": 3}
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_identical_logs_give_identical_bytes(tmp_path, fmt):
+    arena = default_arena()
+    for ids in ("int", "text"):
+        log = make_log(ids)
+        truth = {"xa": np.arange(log.n_events, dtype=float), "ya": np.zeros(log.n_events),
+                 "xb": np.ones(log.n_events), "yb": np.full(log.n_events, 1 / 3)}
+        first = write_log(log, tmp_path / f"{ids}1", fmt=fmt, truth=truth, arena=arena)
+        second = write_log(make_log(ids), tmp_path / f"{ids}2", fmt=fmt, truth=truth, arena=arena)
+        assert [p.name for p in first] == [p.name for p in second]
+        for p, q in zip(first, second):
+            assert p.read_bytes() == q.read_bytes(), p.name
+
+
+def test_meta_json_layout(tmp_path):
+    log = make_log("text")
+    write_log(log, tmp_path)
+    text = (tmp_path / "meta.json").read_text()
+    meta = json.loads(text)
+    assert text == json.dumps(meta, sort_keys=True, indent=2) + "\n"
+    assert meta["static"] == [{"agent": 'say "hi"', "time": 12.25}, {"agent": "é", "time": 10.0}]
+    assert meta["agent_count"] == 6 and meta["agent_ids"] == log.agent_ids.tolist()
+    write_log(make_log("int"), tmp_path / "ints")
+    meta = read_json(tmp_path / "ints" / "meta.json")
+    assert meta["agent_count"] == 6 and "agent_ids" not in meta
+
+
+def test_csv_layout_is_plain(tmp_path):
+    log = EncounterLog.from_records([0.5, 0.25], [1, 2], [2, 3], status=([0.0], [2], ["WF"]))
+    write_log(log, tmp_path)
+    assert (tmp_path / "events.csv").read_text() == '"t","a","b"\n0.25,2,3\n0.5,1,2\n'
+    assert (tmp_path / "status.csv").read_text() == '"t","agent","state"\n0,2,"WF"\n'
+
+
+def test_writing_replaces_stale_contract_files_only(tmp_path):
+    log = make_log()
+    truth = {k: np.zeros(log.n_events) for k in ("xa", "ya", "xb", "yb")}
+    write_log(log, tmp_path, fmt="parquet", truth=truth, arena=default_arena())
+    (tmp_path / "notes.txt").write_text("mine")
+    written = write_log(make_log(status=False), tmp_path, fmt="csv")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["events.csv", "meta.json", "notes.txt"]
+    assert sorted(p.name for p in written) == ["events.csv", "meta.json"]
+
+
+def test_unknown_format():
+    with pytest.raises(SwarmtopoError, match="unknown log format 'xlsx'"):
+        write_log(make_log(), "unused", fmt="xlsx")
+
+
+# -- ID kinds in CSV ------------------------------------------------------------------------
+@pytest.mark.parametrize("rows, expected", [
+    ("0,1,2\n1,2,3\n", [1, 2, 3]),
+    ("0,007,8\n1,8,9\n", ["007", "8", "9"]),
+    ("0,1,x\n1,2,3\n", ["1", "2", "3", "x"]),
+    ("0,1, 2\n1, 2 ,3\n", [1, 2, 3]),
+    ("0,1,2.0\n", ["1", "2.0"]),
+    ("0,-1,99999999999999999999\n", ["-1", "99999999999999999999"]),
+])
+def test_csv_id_kinds(tmp_path, rows, expected):
+    (tmp_path / "events.csv").write_text("t,a,b\n" + rows)
+    assert read_log(tmp_path).agent_ids.tolist() == expected
+
+
+def test_text_ids_in_status_make_every_id_text(tmp_path):
+    (tmp_path / "events.csv").write_text("t,a,b\n0,1,2\n")
+    (tmp_path / "status.csv").write_text("t,agent,state\n0,A,RW\n")
+    assert read_log(tmp_path).agent_ids.tolist() == ["1", "2", "A"]
+
+
+def test_declared_text_ids_keep_digit_strings(tmp_path):
+    (tmp_path / "events.csv").write_text("t,a,b\n0,1,2\n")
+    (tmp_path / "meta.json").write_text('{"agent_ids": ["1", "2", "3"]}')
+    log = read_log(tmp_path)
+    assert log.agent_ids.tolist() == ["1", "2", "3"] and log.n_agents == 3
+
+
+def test_header_with_blanks_and_extra_columns(tmp_path):
+    (tmp_path / "events.csv").write_text("\ufeff t , a,b ,note\n1.5, 3 ,4,hello\n")
+    log = read_log(tmp_path)
+    assert log.t.tolist() == [1.5] and log.agent_ids.tolist() == [3, 4]
+
+
+def test_parquet_types(tmp_path):
+    table = pa.table({"t": pa.array([2, 1], pa.int32()), "a": pa.array([1, 2], pa.uint8()),
+                      "b": pa.array(["3", "4"]).dictionary_encode()})
+    pq.write_table(table, tmp_path / "events.parquet")
+    log = read_log(tmp_path)  # an integer column and a text column: all IDs become text
+    assert log.t.tolist() == [1.0, 2.0] and log.agent_ids.tolist() == ["1", "2", "3", "4"]
+    pq.write_table(pa.table({"t": [0.0], "a": pa.array(["007"]), "b": pa.array(["8"])}), tmp_path / "events.parquet")
+    assert read_log(tmp_path).agent_ids.tolist() == ["007", "8"]
+
+
+# -- located errors -------------------------------------------------------------------------
+def folder(tmp_path, events, status=None, meta=None):
+    (tmp_path / "events.csv").write_text(events)
+    if status is not None:
+        (tmp_path / "status.csv").write_text(status)
+    if meta is not None:
+        (tmp_path / "meta.json").write_text(meta)
+    return tmp_path
+
+
+def read_error(path) -> InputError:
+    with pytest.raises(InputError) as info:
+        read_log(path)
+    return info.value
+
+
+@pytest.mark.parametrize("events, row, column, value, reason", [
+    ("t,a,b\n0,1,2\nabc,2,3\n", 2, "t", "abc", "time is not a number"),
+    ("t,a,b\n0,1,2\n1,2,3\n2,3,4\n0x5,1,3\n", 4, "t", "0x5", "time is not a number"),
+    ("t,a,b\n0,1,2\nNaN,2,3\n", 2, "t", "nan", "finite"),
+    ("t,a,b\n0,1,2\n1,2,3\n-2,3,4\n", 3, "t", -2.0, "negative"),
+    ("t,a,b\n0,1,2\n,2,3\n", 2, "t", "", "time is missing"),
+    ("t,a,b\n0,1,2\n1,2,2\n", 2, "b", 2, "itself"),
+    ("t,a,b\n0,x,y\n1,,y\n", 2, "a", "", "agent ID is missing"),
+    ("t,a,b\n0,x,y\n1,y,x\n0,y,x\n", 3, None, None, "duplicate event: same time and pair as row 1"),
+])
+def test_bad_events_are_located(tmp_path, events, row, column, value, reason):
+    err = read_error(folder(tmp_path, events))
+    assert err.file == str(tmp_path / "events.csv")
+    assert err.row == row
+    assert reason in str(err)
+    if column is not None:
+        assert err.column == column
+    if value == "nan":
+        assert np.isnan(err.value)
+    elif value is not None:
+        assert err.value == value
+
+
+def test_missing_column_names_the_columns_found(tmp_path):
+    err = read_error(folder(tmp_path, "time,a,b\n0,1,2\n"))
+    assert err.file == str(tmp_path / "events.csv") and err.column == "t"
+    assert "missing column 't'; found columns: 'time', 'a', 'b'" in str(err)
+    (tmp_path / "status.csv").write_text("t,agent\n0,1\n")
+    (tmp_path / "events.csv").write_text("t,a,b\n0,1,2\n")
+    err = read_error(tmp_path)
+    assert err.file == str(tmp_path / "status.csv") and err.column == "state"
+
+
+def test_unknown_state_and_undeclared_id(tmp_path):
+    err = read_error(folder(tmp_path, "t,a,b\n0,1,2\n", status="t,agent,state\n0,1,RW\n1,2,walk\n"))
+    assert (err.file, err.row, err.column, err.value) == (str(tmp_path / "status.csv"), 2, "state", "walk")
+    second = tmp_path / "second"
+    second.mkdir()
+    err = read_error(folder(second, "t,a,b\n0,0,1\n1,1,5\n", meta='{"agent_count": 3}'))
+    assert (err.file, err.row, err.column, err.value) == (str(second / "events.csv"), 2, "b", 5)
+
+
+def test_an_agent_that_met_nobody_is_fine(tmp_path):
+    log = read_log(folder(tmp_path, "t,a,b\n0,0,1\n", status="t,agent,state\n0,2,S\n",
+                          meta='{"agent_count": 4}'))
+    assert log.n_agents == 4 and log.stop_intervals()[0].tolist() == [2]
+
+
+def test_unsorted_input_is_sorted(tmp_path):
+    log = read_log(folder(tmp_path, "t,a,b\n3,1,0\n1,2,1\n1,0,2\n"))
+    assert log.t.tolist() == [1.0, 1.0, 3.0]
+    assert log.a.tolist() == [0, 1, 0] and log.b.tolist() == [2, 2, 1]
+
+
+def test_ragged_csv_row(tmp_path):
+    err = read_error(folder(tmp_path, "t,a,b\n0,1,2\n\n1,2\n"))
+    assert err.file == str(tmp_path / "events.csv")
+    assert "row 2: cannot parse CSV (Expected 3 columns, got 2" in str(err)
+
+
+def test_empty_and_missing_files(tmp_path):
+    err = read_error(folder(tmp_path, ""))
+    assert "cannot parse CSV" in str(err) and err.file == str(tmp_path / "events.csv")
+    (tmp_path / "events.csv").unlink()
+    assert "no events.csv or events.parquet" in str(read_error(tmp_path))
+    assert "log folder not found" in str(read_error(tmp_path / "nope"))
+
+
+def test_both_formats_present(tmp_path):
+    write_log(make_log(), tmp_path, fmt="csv")
+    pq.write_table(pa.table({"t": [0.0], "a": [0], "b": [1]}), tmp_path / "events.parquet")
+    assert "both events.csv and events.parquet exist" in str(read_error(tmp_path))
+
+
+def test_parquet_errors_are_located(tmp_path):
+    pq.write_table(pa.table({"t": pa.array([0.0, None, 2.0]), "a": [0, 1, 2], "b": [1, 2, 3]}),
+                   tmp_path / "events.parquet")
+    err = read_error(tmp_path)
+    assert (err.file, err.row, err.column) == (str(tmp_path / "events.parquet"), 2, "t")
+    pq.write_table(pa.table({"t": ["0", "1", "2", "soon"], "a": [0, 1, 2, 3], "b": [1, 2, 3, 4]}),
+                   tmp_path / "events.parquet")
+    err = read_error(tmp_path)
+    assert (err.row, err.column, err.value) == (4, "t", "soon")
+    pq.write_table(pa.table({"t": [0.0, 1.0], "a": pa.array(["x", None]), "b": ["y", "z"]}),
+                   tmp_path / "events.parquet")
+    err = read_error(tmp_path)
+    assert (err.row, err.column) == (2, "a") and "missing" in str(err)
+    (tmp_path / "events.parquet").write_bytes(b"not parquet")
+    assert "cannot read Parquet file" in str(read_error(tmp_path))
+
+
+@pytest.mark.parametrize("meta, fragment", [
+    ('{"agent_count": 3,\n  "seed": 1,,}', "invalid JSON: Expecting property name enclosed in double quotes "
+                                           "(line 2, column 13)"),
+    ("[1, 2]", "meta.json must hold a JSON object"),
+    ('{"static": {"agent": 1}}', "key 'static' must be a list"),
+    ('{"static": [{"agent": 1, "time": 2}, {"agent": 2}]}', "key 'static': entry 2 must be an object"),
+    ('{"agent_count": -1}', "key 'agent_count' must be a non-negative integer"),
+    ('{"agent_count": 2.5}', "key 'agent_count' must be a non-negative integer"),
+    ('{"agent_ids": [1, null]}', "key 'agent_ids': entry 2"),
+    ('{"agent_ids": [1, 2], "agent_count": 3}', "key 'agent_count' is 3 but 'agent_ids' lists 2 agents"),
+])
+def test_bad_meta_names_the_file_and_key(tmp_path, meta, fragment):
+    err = read_error(folder(tmp_path, "t,a,b\n0,1,2\n", meta=meta))
+    assert err.file == str(tmp_path / "meta.json")
+    assert fragment in str(err)
+
+
+def test_bad_static_entry_is_located(tmp_path):
+    err = read_error(folder(tmp_path, "t,a,b\n0,1,2\n",
+                            meta='{"static": [{"agent": 1, "time": 2}, {"agent": 2, "time": -1}]}'))
+    assert err.file == f"{tmp_path / 'meta.json'} static"
+    assert (err.row, err.column, err.value) == (2, "time", -1)
+
+
+# -- ground truth ---------------------------------------------------------------------------------
+def truth_and_trajectories(log):
+    rng = np.random.default_rng(2)
+    n = log.n_events
+    truth = {"t": log.t, "a": log.a, "b": log.b, "xa": rng.uniform(0, 500, n), "ya": rng.uniform(0, 500, n),
+             "xb": rng.uniform(0, 500, n), "yb": rng.uniform(0, 500, n), "region": rng.integers(0, 2, n)}
+    ids = log.agent_ids
+    trajectories = {"t": np.repeat([0.0, 0.1], len(ids)), "agent": np.tile(ids, 2),
+                    "x": rng.uniform(0, 500, 2 * len(ids)), "y": rng.uniform(0, 500, 2 * len(ids)),
+                    "state": rng.integers(0, 3, 2 * len(ids)).astype(np.int8)}
+    return truth, trajectories
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+@pytest.mark.parametrize("ids", ["int", "text"])
+def test_truth_and_trajectories_round_trip(tmp_path, fmt, ids):
+    log = make_log(ids)
+    truth, traj = truth_and_trajectories(log)
+    write_log(log, tmp_path, fmt=fmt, truth=truth, trajectories=traj, arena=default_arena())
+    back = read_truth(tmp_path)
+    assert list(back) == ["t", "a", "b", "xa", "ya", "xb", "yb", "region"]
+    assert np.array_equal(back["t"], log.t)
+    assert back["a"].tolist() == log.ids_of(log.a).tolist() and back["b"].tolist() == log.ids_of(log.b).tolist()
+    for key in ("xa", "ya", "xb", "yb", "region"):
+        assert np.array_equal(back[key], truth[key]), key
+    tr = read_trajectories(tmp_path)
+    assert tr["agent"].tolist() == traj["agent"].tolist()
+    assert tr["state"].dtype == np.int8 and np.array_equal(tr["state"], traj["state"])
+    for key in ("t", "x", "y"):
+        assert np.array_equal(tr[key], traj[key]), key
+    assert read_arena(tmp_path / "arena.geojson") == default_arena()
+
+
+def test_absent_ground_truth_reads_as_none(tmp_path):
+    write_log(make_log(), tmp_path)
+    assert read_truth(tmp_path) is None and read_trajectories(tmp_path) is None
+
+
+def test_misaligned_truth_is_refused(tmp_path):
+    log = make_log()
+    truth, _ = truth_and_trajectories(log)
+    with pytest.raises(ValueError, match="truth\\['a'\\] is not aligned"):
+        write_log(log, tmp_path, truth={**truth, "a": truth["b"]})
+    with pytest.raises(ValueError, match="rows"):
+        write_log(log, tmp_path, truth={**truth, "xa": truth["xa"][:-1]})
+    with pytest.raises(ValueError, match="lacks column"):
+        write_log(log, tmp_path, truth={"xa": truth["xa"]})
+
+
+def test_strip_ground_truth(tmp_path):
+    log = make_log("text", meta={"r_d": 30.0, "simulation": {"arena": "default", "holes": 1}})
+    truth, traj = truth_and_trajectories(log)
+    src, dst = tmp_path / "full", tmp_path / "stripped"
+    write_log(log, src, truth=truth, trajectories=traj, arena=default_arena())
+    assert {"arena.geojson", "truth.csv", "trajectories.csv"} <= {p.name for p in src.iterdir()}
+    strip_ground_truth(src, dst)
+    assert sorted(p.name for p in dst.iterdir()) == ["events.csv", "meta.json", "status.csv"]
+    assert not set(GROUND_TRUTH_FILES) & {p.name for p in dst.iterdir()}
+    for name in ("events.csv", "status.csv"):
+        assert (dst / name).read_bytes() == (src / name).read_bytes()
+    meta_src, meta_dst = read_json(src / "meta.json"), read_json(dst / "meta.json")
+    assert "simulation" in meta_src and "simulation" not in meta_dst
+    assert meta_dst == {k: v for k, v in meta_src.items() if k != "simulation"}
+    stripped = read_log(dst)
+    assert_same_log(log, stripped)
+    with pytest.raises(InputError, match="new or empty folder"):
+        strip_ground_truth(src, dst)
+
+
+# -- JSON ----------------------------------------------------------------------------------------
+def test_json_helpers(tmp_path):
+    path = write_json({"b": np.int64(3), "a": [np.float64(0.5), np.arange(2)], "c": np.bool_(True)},
+                      tmp_path / "x.json")
+    expected = '{\n  "a": [\n    0.5,\n    [\n      0,\n      1\n    ]\n  ],\n  "b": 3,\n  "c": true\n}\n'
+    assert path.read_text() == expected
+    assert read_json(path) == {"a": [0.5, [0, 1]], "b": 3, "c": True}
+    with pytest.raises(InputError, match="cannot write JSON") as info:
+        write_json({"duration": float("nan")}, tmp_path / "nan.json")
+    assert info.value.file == str(tmp_path / "nan.json") and not (tmp_path / "nan.json").exists()
+    with pytest.raises(InputError, match="file not found"):
+        read_json(tmp_path / "missing.json")
+    (tmp_path / "bin.json").write_bytes(b'{"a": "\xff"}')
+    with pytest.raises(InputError, match="not UTF-8"):
+        read_json(tmp_path / "bin.json")
+
+
+# -- size ------------------------------------------------------------------------------------------
+def big_events(path, n, text):
+    rng = np.random.default_rng(0)
+    n_agents = 400
+    t = np.sort(rng.uniform(0, 600, n))
+    a = rng.integers(0, n_agents, n)
+    b = (a + rng.integers(1, n_agents, n)) % n_agents
+    names = [f"rob{i:03d}" for i in range(n_agents)]
+    cols = (pa.DictionaryArray.from_arrays(a, names), pa.DictionaryArray.from_arrays(b, names)) if text else (a, b)
+    table = pa.table({"t": t, "a": cols[0], "b": cols[1]})
+    if path.suffix == ".csv":
+        pcsv.write_csv(table, path)
+    else:
+        pq.write_table(table, path)
+    return t, np.minimum(a, b), np.maximum(a, b)
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_large_log_reads_correctly(tmp_path, suffix):
+    t, lo, hi = big_events(tmp_path / f"events{suffix}", 10**5, text=True)
+    log = read_log(tmp_path)
+    assert np.array_equal(log.t, t) and np.array_equal(log.a, lo) and np.array_equal(log.b, hi)
+    assert log.agent_ids[:2].tolist() == ["rob000", "rob001"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("text", [False, True])
+def test_a_million_csv_rows_read_fast(tmp_path, text):
+    t, lo, hi = big_events(tmp_path / "events.csv", 10**6, text=text)
+    start = time.perf_counter()
+    log = read_log(tmp_path)
+    elapsed = time.perf_counter() - start
+    assert log.n_events == 10**6 and np.array_equal(log.a, lo) and np.array_equal(log.b, hi)
+    assert elapsed < 20.0  # about 1 s on an idle core; generous for a loaded 2-core machine

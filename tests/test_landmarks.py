@@ -1,0 +1,333 @@
+"""Landmark subsampling: agreement with dense literal versions, theorems, robustness."""
+
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components, shortest_path
+from scipy.spatial import cKDTree
+
+from swarmtopo.errors import InputError, SwarmtopoError
+from swarmtopo.graph import build_graph, literal_distances
+from swarmtopo.landmarks import (SUBSAMPLERS, Landmarks, knn_distances, knn_maxmin, maxmin,
+                                 probabilistic_maxmin)
+from swarmtopo.log import EncounterLog
+
+RTOL = 1e-12  # distances from different Dijkstra codes differ only by summation rounding
+
+
+@dataclass(frozen=True, eq=False)
+class Graph:
+    """The part of EncounterGraph the landmark code reads."""
+
+    adjacency: sp.csr_matrix
+    multiplicity: np.ndarray
+
+
+def graph_from_edges(n, i, j, w, multiplicity=None) -> Graph:
+    i, j, w = np.asarray(i), np.asarray(j), np.asarray(w, float)
+    adjacency = sp.csr_matrix((np.r_[w, w], (np.r_[i, j], np.r_[j, i])), shape=(n, n))
+    mult = np.ones(n, np.int64) if multiplicity is None else np.asarray(multiplicity, np.int64)
+    return Graph(adjacency, mult)
+
+
+def random_geometric_graph(n, seed, radius=0.18, max_multiplicity=3) -> Graph:
+    """Largest component of a random geometric graph in the unit square, Euclidean weights."""
+    rng = np.random.default_rng(seed)
+    points = rng.uniform(0, 1, (n, 2))
+    pairs = cKDTree(points).query_pairs(radius, output_type="ndarray")
+    w = np.linalg.norm(points[pairs[:, 0]] - points[pairs[:, 1]], axis=1)
+    g = graph_from_edges(n, pairs[:, 0], pairs[:, 1], w, rng.integers(1, max_multiplicity + 1, n))
+    _, labels = connected_components(g.adjacency, directed=False)
+    keep = np.flatnonzero(labels == np.argmax(np.bincount(labels)))
+    return Graph(g.adjacency[keep][:, keep].tocsr(), g.multiplicity[keep])
+
+
+def noisy_cycle_with_outliers(n_cycle=120, n_outliers=4, far=25.0, seed=0) -> tuple[Graph, np.ndarray]:
+    """A cycle with random edge lengths in [0.5, 1.5] and ``n_outliers`` pendant nodes at
+    distance ``far`` from evenly spaced cycle nodes.  Returns the graph and the outliers."""
+    rng = np.random.default_rng(seed)
+    i = np.arange(n_cycle)
+    w = rng.uniform(0.5, 1.5, n_cycle)
+    outliers = np.arange(n_cycle, n_cycle + n_outliers)
+    anchors = np.arange(n_outliers) * (n_cycle // n_outliers)
+    g = graph_from_edges(n_cycle + n_outliers, np.r_[i, outliers], np.r_[(i + 1) % n_cycle, anchors],
+                         np.r_[w, np.full(n_outliers, far)])
+    return g, outliers
+
+
+# -- dense literal versions (all-pairs matrix, textbook loops) ---------------------------
+def dense(g: Graph) -> np.ndarray:
+    return shortest_path(g.adjacency, directed=False)
+
+
+def literal_knn(g: Graph, k: int) -> np.ndarray:
+    """k-NN distances of every node from the event-level point cloud (multiplicity expanded)."""
+    node_of_event = np.repeat(np.arange(len(g.multiplicity)), g.multiplicity)
+    d_events = dense(g)[np.ix_(node_of_event, node_of_event)]
+    first_event = np.searchsorted(node_of_event, np.arange(len(g.multiplicity)))
+    rows = []
+    for e in first_event:
+        others = np.sort(np.delete(d_events[e], e))
+        rows.append(np.r_[others, np.full(k, np.inf)][:k])
+    return np.array(rows)
+
+
+def literal_farthest_points(d, candidates, n_landmarks, start, bonus=None):
+    """Textbook maxmin on a full matrix; ``bonus(r)`` turns it into argmax u + bonus."""
+    chosen, u = [start], d[start].copy()
+    radii = [u[candidates].max()]
+    while len(chosen) < min(n_landmarks, candidates.sum()):
+        if bonus is None:
+            score = np.where(candidates, u, -np.inf)
+        else:
+            score = u + bonus(radii[-1])
+            score[chosen] = -np.inf
+        x = int(np.argmax(score))
+        chosen.append(x)
+        u = np.minimum(u, d[x])
+        radii.append(u[candidates].max())
+    return np.array(chosen), np.array(radii)
+
+
+def literal_knn_maxmin(g, n_landmarks, k, q, start):
+    mean_knn = literal_knn(g, k).mean(axis=1)
+    event_values = np.repeat(mean_knn, g.multiplicity)  # one value per event
+    keep = mean_knn <= np.quantile(event_values, q)
+    return literal_farthest_points(dense(g), keep, n_landmarks, start)
+
+
+def literal_probabilistic(g, n_landmarks, k, omega, start):
+    mean_knn = literal_knn(g, k).mean(axis=1)
+    event_values = np.repeat(mean_knn, g.multiplicity)
+    rho = np.array([(event_values > m).mean() for m in mean_knn])
+    return literal_farthest_points(dense(g), np.ones(len(mean_knn), bool), n_landmarks, start,
+                                   bonus=lambda r: (omega * r) * rho)
+
+
+def assert_matches(result: Landmarks, g: Graph, nodes, radii):
+    np.testing.assert_array_equal(result.nodes, nodes)
+    np.testing.assert_allclose(result.cover_radii, radii, rtol=RTOL)
+    np.testing.assert_allclose(result.distances, dense(g)[np.ix_(nodes, nodes)], rtol=RTOL)
+    assert result.cover_radius == result.cover_radii[-1]
+
+
+# -- agreement with the literal versions --------------------------------------------------
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_maxmin_equals_dense_literal(seed):
+    g = random_geometric_graph(250, seed)
+    result = maxmin(g, 30, rng=seed)
+    nodes, radii = literal_farthest_points(dense(g), np.ones(len(g.multiplicity), bool), 30,
+                                           result.nodes[0])
+    assert_matches(result, g, nodes, radii)
+    assert result.method == "maxmin" and result.params["start"] == result.nodes[0]
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_knn_maxmin_equals_dense_literal(seed):
+    g = random_geometric_graph(250, seed)
+    result = knn_maxmin(g, 30, k=7, q=0.8, rng=seed)
+    nodes, radii = literal_knn_maxmin(g, 30, 7, 0.8, result.nodes[0])
+    assert_matches(result, g, nodes, radii)
+    mean_knn = literal_knn(g, 7).mean(axis=1)
+    kept = mean_knn <= result.params["threshold"]
+    assert result.params["n_kept"] == kept.sum() < len(kept)
+    assert kept[result.nodes].all()
+
+
+@pytest.mark.parametrize("omega", [0.3, 1.0, 4.0])
+def test_probabilistic_maxmin_equals_dense_literal(omega):
+    g = random_geometric_graph(250, 5)
+    result = probabilistic_maxmin(g, 30, k=6, omega=omega, rng=5)
+    nodes, radii = literal_probabilistic(g, 30, 6, omega, result.nodes[0])
+    assert_matches(result, g, nodes, radii)
+    assert result.params == {"k": 6, "omega": omega, "start": int(result.nodes[0])}
+
+
+def test_knn_distances_equal_dense_literal():
+    g = random_geometric_graph(200, 3, max_multiplicity=4)
+    for k in (1, 5, 12):
+        np.testing.assert_allclose(knn_distances(g, k), literal_knn(g, k), rtol=RTOL)
+
+
+def test_knn_distances_hand_computed_with_multiplicity():
+    # path 0 --1-- 1 --2-- 2, node 0 stands for 3 events, nodes 1 and 2 for one each:
+    # from node 0: two co-merged events at 0, node 1 at 1, node 2 at 3, then nothing.
+    g = graph_from_edges(3, [0, 1], [1, 2], [1.0, 2.0], multiplicity=[3, 1, 1])
+    expected = np.array([[0, 0, 1, 3, np.inf],
+                         [1, 1, 1, 2, np.inf],
+                         [2, 3, 3, 3, np.inf]])
+    np.testing.assert_array_equal(knn_distances(g, 5), expected)
+    np.testing.assert_array_equal(knn_distances(g, 2), expected[:, :2])
+
+
+@pytest.mark.parametrize("metric", ["plain", "contracted"])
+def test_knn_and_maxmin_on_an_encounter_graph_match_the_event_metric(metric):
+    # real merged nodes: times on a 0.5 s grid (equal times on one agent merge) and two
+    # stops (contracted metric); the reference is the paper's literal event-level metric
+    rng = np.random.default_rng(3)
+    t = np.sort(rng.integers(0, 40, 90)) * 0.5
+    a = rng.integers(0, 6, 90)
+    b = (a + rng.integers(1, 6, 90)) % 6
+    keep = np.unique(np.c_[t, np.minimum(a, b), np.maximum(a, b)], axis=0, return_index=True)[1]
+    log = EncounterLog.from_records(t[keep], a[keep], b[keep],
+                                    status=([4, 12, 6, 15], [1, 1, 4, 4], ["S", "RW", "S", "RW"]))
+    graph = build_graph(log, metric)
+    assert graph.components()[0] == 1 and graph.multiplicity.max() > 1
+    d_events = literal_distances(log, metric)
+    first_event = np.unique(graph.node_of_event, return_index=True)[1]
+    for k in (1, 4, 9):
+        expected = [np.sort(np.delete(d_events[e], e))[:k] for e in first_event]
+        np.testing.assert_allclose(knn_distances(graph, k), expected, rtol=RTOL)
+    result = maxmin(graph, 12, rng=0)
+    np.testing.assert_allclose(result.distances, d_events[np.ix_(first_event[result.nodes],
+                                                                 first_event[result.nodes])], rtol=RTOL)
+
+
+def test_maxmin_on_a_path_hand_computed():
+    # path 0-1-2-3-4, unit weights, start 2: farthest are 0 and 4 (tie -> 0), then 4,
+    # then 1 (tie with 3), then 3.  Radii: 2, 2, 1, 1, 0.
+    g = graph_from_edges(5, [0, 1, 2, 3], [1, 2, 3, 4], np.ones(4))
+    seed = next(s for s in range(100) if np.random.default_rng(s).integers(5) == 2)
+    result = maxmin(g, 5, rng=seed)
+    np.testing.assert_array_equal(result.nodes, [2, 0, 4, 1, 3])
+    np.testing.assert_array_equal(result.cover_radii, [2, 2, 1, 1, 0])
+    np.testing.assert_array_equal(result.distances, np.abs(np.subtract.outer(result.nodes, result.nodes)))
+
+
+# -- theorems ------------------------------------------------------------------------------
+@pytest.mark.parametrize("method", ["maxmin", "knn", "probabilistic"])
+def test_cover_radius_bounds_every_candidate(method):
+    g = random_geometric_graph(300, 11)
+    result = SUBSAMPLERS[method](g, 25, rng=4)
+    d = dense(g)
+    if method == "knn":
+        candidates = literal_knn(g, 10).mean(axis=1) <= result.params["threshold"]
+    else:
+        candidates = np.ones(len(g.multiplicity), bool)
+    to_landmarks = d[:, result.nodes].min(axis=1)
+    assert np.all(np.diff(result.cover_radii) <= 0)
+    assert to_landmarks[candidates].max() == pytest.approx(result.cover_radius, rel=RTOL)
+    # after i + 1 picks every candidate is within cover_radii[i] of the first i + 1 landmarks
+    for i in range(len(result.nodes)):
+        reach = d[:, result.nodes[: i + 1]].min(axis=1)[candidates].max()
+        assert reach == pytest.approx(result.cover_radii[i], rel=RTOL)
+
+
+@pytest.mark.parametrize("method", ["maxmin", "knn"])
+def test_maxmin_separation_property(method):
+    # the j-th landmark was the farthest candidate: d(l_i, l_j) >= cover radius before it
+    g = random_geometric_graph(300, 12)
+    result = SUBSAMPLERS[method](g, 40, rng=1)
+    dist = result.distances
+    for j in range(1, len(result.nodes)):
+        assert dist[j, :j].min() >= result.cover_radii[j - 1] * (1 - RTOL)
+        assert dist[j, :j].min() == pytest.approx(result.cover_radii[j - 1], rel=RTOL)
+
+
+def test_distances_matrix_is_a_metric_on_landmarks():
+    result = maxmin(random_geometric_graph(200, 8), 20, rng=0)
+    dist = result.distances
+    assert dist.dtype == np.float64 and dist.shape == (20, 20)
+    np.testing.assert_array_equal(dist, dist.T)
+    np.testing.assert_array_equal(np.diag(dist), 0)
+    assert (dist[~np.eye(20, dtype=bool)] > 0).all()
+
+
+@pytest.mark.parametrize("method", ["maxmin", "knn", "probabilistic"])
+def test_more_landmarks_than_points_takes_all(method):
+    g = random_geometric_graph(40, 9)
+    n = len(g.multiplicity)
+    result = SUBSAMPLERS[method](g, n + 5, k=3, rng=0) if method != "maxmin" else maxmin(g, n + 5, rng=0)
+    n_candidates = result.params.get("n_kept", n)
+    assert len(result.nodes) == len(np.unique(result.nodes)) == n_candidates
+    assert result.cover_radius == 0.0
+    np.testing.assert_allclose(result.distances, dense(g)[np.ix_(result.nodes, result.nodes)], rtol=RTOL)
+
+
+def test_probabilistic_with_omega_zero_is_maxmin():
+    g = random_geometric_graph(250, 6)
+    a, b = maxmin(g, 30, rng=2), probabilistic_maxmin(g, 30, omega=0.0, rng=2)
+    np.testing.assert_array_equal(a.nodes, b.nodes)
+    np.testing.assert_array_equal(a.cover_radii, b.cover_radii)
+
+
+@pytest.mark.parametrize("method", ["maxmin", "knn", "probabilistic"])
+def test_choices_are_scale_invariant(method):
+    # omega is unit-free and the k-NN quantile is a rank: scaling the metric by a power
+    # of two (exact in floating point) scales radii and distances and changes no choice
+    g = random_geometric_graph(200, 7)
+    scaled = Graph(g.adjacency * 8.0, g.multiplicity)
+    a, b = SUBSAMPLERS[method](g, 25, rng=3), SUBSAMPLERS[method](scaled, 25, rng=3)
+    np.testing.assert_array_equal(a.nodes, b.nodes)
+    np.testing.assert_array_equal(a.cover_radii * 8.0, b.cover_radii)
+    np.testing.assert_array_equal(a.distances * 8.0, b.distances)
+
+
+# -- outliers ---------------------------------------------------------------------------------
+def test_knn_filtering_ignores_outliers_maxmin_does_not():
+    # 4 outliers in 124 points (3%): their 10-NN mean is about far + 3, the cycle points'
+    # about 3, so the 0.9-quantile drops them (with the 8 sparsest cycle points).
+    # maxmin's second pick is already an outlier: they are the farthest points.
+    g, outliers = noisy_cycle_with_outliers()
+    for seed in range(5):
+        plain = maxmin(g, 12, rng=seed)
+        assert np.isin(plain.nodes[1:5], outliers).sum() >= 3
+        filtered = knn_maxmin(g, 12, rng=seed)
+        assert not np.isin(filtered.nodes, outliers).any()
+        assert filtered.params["n_kept"] >= int(0.9 * len(g.multiplicity))
+        assert (knn_distances(g, 10)[outliers].mean(axis=1) > filtered.params["threshold"]).all()
+        soft = probabilistic_maxmin(g, 12, omega=1.0, rng=seed)
+        assert np.isin(soft.nodes, outliers).sum() < np.isin(plain.nodes, outliers).sum()
+
+
+# -- determinism and errors ------------------------------------------------------------------
+@pytest.mark.parametrize("method", ["maxmin", "knn", "probabilistic"])
+def test_same_seed_same_bytes_and_start_rule(method):
+    g = random_geometric_graph(200, 4)
+    a, b = SUBSAMPLERS[method](g, 20, rng=7), SUBSAMPLERS[method](g, 20, rng=np.random.default_rng(7))
+    assert a.nodes.tobytes() == b.nodes.tobytes() and a.distances.tobytes() == b.distances.tobytes()
+    assert a.cover_radii.tobytes() == b.cover_radii.tobytes() and a.params == b.params
+    starts = {int(SUBSAMPLERS[method](g, 2, rng=s).nodes[0]) for s in range(6)}
+    assert len(starts) > 1
+    if method != "knn":  # the start is a uniform draw from the candidate nodes
+        assert a.nodes[0] == np.random.default_rng(7).integers(len(g.multiplicity))
+
+
+@pytest.mark.parametrize("method", ["maxmin", "knn", "probabilistic"])
+def test_disconnected_graph_is_a_clear_error(method):
+    g = graph_from_edges(6, [0, 1, 3, 4], [1, 2, 4, 5], np.ones(4))
+    with pytest.raises(SwarmtopoError, match="not connected"):
+        SUBSAMPLERS[method](g, 3, k=2, rng=0) if method != "maxmin" else maxmin(g, 3, rng=0)
+
+
+@pytest.mark.parametrize("call", [
+    lambda g: maxmin(g, 0),
+    lambda g: maxmin(g, 2.5),
+    lambda g: knn_maxmin(g, 3, k=0),
+    lambda g: knn_maxmin(g, 3, q=0.0),
+    lambda g: knn_maxmin(g, 3, q=1.5),
+    lambda g: knn_maxmin(g, 3, k=5),  # 5 events: k must be < 5
+    lambda g: probabilistic_maxmin(g, 3, omega=-1.0),
+    lambda g: knn_distances(g, 0),
+])
+def test_bad_parameters_are_input_errors(call):
+    g = graph_from_edges(5, [0, 1, 2, 3], [1, 2, 3, 4], np.ones(4))
+    with pytest.raises(InputError):
+        call(g)
+
+
+def test_nonpositive_weights_are_rejected():
+    adjacency = sp.csr_matrix(np.array([[0, 1, 0], [1, 0, -1], [0, -1, 0]], float))
+    with pytest.raises(InputError, match="> 0"):
+        maxmin(Graph(adjacency, np.ones(3, np.int64)), 2)
+
+
+@pytest.mark.parametrize("method, stages", [("maxmin", ["picks", "distances", "done"]),
+                                            ("knn", ["knn", "picks", "distances", "done"]),
+                                            ("probabilistic", ["knn", "picks", "distances", "done"])])
+def test_progress_reports_each_stage_once_in_order(method, stages):
+    seen = []
+    SUBSAMPLERS[method](random_geometric_graph(60, 0), 5, rng=0, progress=seen.append)
+    assert seen == stages

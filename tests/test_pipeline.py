@@ -1,0 +1,127 @@
+"""End-to-end mapping: log -> TopologicalMap, checked against known topology."""
+
+import json
+
+import numpy as np
+import pytest
+
+from swarmtopo.arena import default_arena, square_arena, two_rooms_arena
+from swarmtopo.errors import SwarmtopoError
+from swarmtopo.log import EncounterLog
+from swarmtopo.pipeline import MapConfig, _share_landmarks, map_encounters
+from swarmtopo.sim import simulate
+
+FAST = dict(embed_dim=0)
+
+
+def ring_log(n_agents=120, jitter=0.05, rng=0):
+    """Agents 0..n-1 on a ring; agent i meets i+1 at time (i mod 2) + noise.
+
+    Events E_i = [t_i, i, i+1] and E_{i+1} share agent i+1, so under the plain metric
+    the event graph is a cycle of n events with edge weights ~1: a noisy circle of
+    circumference ~n seconds.
+    """
+    rng = np.random.default_rng(rng)
+    i = np.arange(n_agents)
+    t = (i % 2) + 5.0 + rng.uniform(-jitter, jitter, n_agents)
+    return EncounterLog.from_records(t, i, (i + 1) % n_agents)
+
+
+def test_noisy_circle_of_events_gives_one_dominant_h1_bar():
+    tmap = map_encounters(ring_log(), MapConfig(metric="plain", landmarks=60, min_region_events=10, **FAST))
+    lengths = tmap.diagram.lengths(1)
+    assert tmap.betti == {0: 1, 1: 1}
+    # A cycle of circumference C ~ 120 s sampled every ~2 s: the hole bar lives from
+    # ~2 s to ~C/3 = 40 s; every other bar is subsampling noise of a few seconds.
+    assert lengths[0] > 30 and (len(lengths) == 1 or lengths[0] > 5 * lengths[1])
+
+
+def test_two_disjoint_rooms_give_two_regions():
+    sim = simulate(two_rooms_arena(), 200, 20.0, rng=7)
+    tmap = map_encounters(sim.log, MapConfig(**FAST))
+    assert tmap.betti[0] == 2
+    assert len(tmap.regions) == 2
+    # one infinite H0 bar per region in the union diagram
+    assert np.isinf(tmap.diagram[0][:, 1]).sum() == 2
+    assert sum(r.n_events for r in tmap.regions) + sum(s["events"] for s in tmap.too_little_data) == sim.log.n_events
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("arena, holes", [(default_arena(), 1), (square_arena(), 0)], ids=["one-hole", "no-hole"])
+def test_simulated_arenas_map_to_their_hole_count(arena, holes):
+    """The paper's Fig. "encmds" set-up (200 agents, 20 s), default map options.
+
+    Measured on seeds 0-19 with the interim cover-radius rule: 18/20 one-hole and
+    19/20 no-hole maps were exact.  On the fixed seeds 0-9 we require at least 8/10
+    (a true rate of 0.9 gives 8 or more in 93% of seed sets; the seeds are fixed, so
+    this test is deterministic and fails only if the pipeline gets worse).
+    """
+    right = 0
+    for seed in range(10):
+        sim = simulate(arena, 200, 20.0, rng=seed)
+        tmap = map_encounters(sim.log, MapConfig(seed=seed, **FAST))
+        assert tmap.betti[0] == 1
+        right += tmap.betti[1] == holes
+    assert right >= 8
+
+
+def test_same_seed_same_map_and_seed_matters():
+    log = simulate(default_arena(), 120, 10.0, rng=3).log
+    docs = [map_encounters(log, MapConfig(seed=s, landmarks=60, embed_dim=3)).to_json() for s in (5, 5, 6)]
+    for d in docs:
+        d.pop("timings")
+    assert json.dumps(docs[0]) == json.dumps(docs[1])
+    assert docs[0]["diagrams"] != docs[2]["diagrams"]
+
+
+def test_small_component_is_reported_not_counted():
+    big = ring_log(80)
+    t = np.r_[big.t, 1.0, 2.0]
+    a = np.r_[big.a, 500, 500]
+    b = np.r_[big.b, 501, 502]
+    log = EncounterLog.from_records(t, a, b)
+    tmap = map_encounters(log, MapConfig(metric="plain", landmarks=40, min_region_events=10, **FAST))
+    assert tmap.betti[0] == 1
+    assert tmap.too_little_data == [{"component": tmap.too_little_data[0]["component"], "events": 2, "agents": 3}]
+
+
+def test_one_event_gets_a_clear_message():
+    log = EncounterLog.from_records([1.0], [1], [2])
+    with pytest.raises(SwarmtopoError, match="at least 2 encounters"):
+        map_encounters(log)
+
+
+def test_no_shared_agents_gets_a_clear_message():
+    n = 60
+    log = EncounterLog.from_records(np.arange(n, dtype=float), 2 * np.arange(n), 2 * np.arange(n) + 1)
+    with pytest.raises(SwarmtopoError, match="too short or the agents too few"):
+        map_encounters(log)
+
+
+def test_window_restricts_events():
+    log = simulate(default_arena(), 200, 15.0, rng=1).log
+    tmap = map_encounters(log, MapConfig(window=(2.0, 12.0), **FAST))
+    inside = int(np.count_nonzero((log.t >= 2.0) & (log.t <= 12.0)))
+    assert 0 < inside < log.n_events
+    assert tmap.n_events == inside
+
+
+@pytest.mark.parametrize("bad, match", [
+    (dict(metric="euclid"), "unknown metric"),
+    (dict(subsample="random"), "unknown subsampler"),
+    (dict(landmarks=2), "at least 3"),
+    (dict(maxdim=3), "maxdim"),
+    (dict(window=(5.0, 1.0)), "before its start"),
+])
+def test_bad_config_is_refused(bad, match):
+    with pytest.raises(SwarmtopoError, match=match):
+        map_encounters(ring_log(), MapConfig(**bad))
+
+
+def test_landmark_shares_sum_to_budget_and_respect_sizes():
+    assert _share_landmarks(300, np.array([1000, 500, 500])).tolist() == [150, 75, 75]
+    # largest remainder: 100 * (2/3, 1/3) = 66.67, 33.33 -> 67, 33
+    assert _share_landmarks(100, np.array([200, 100])).tolist() == [67, 33]
+    # a tiny region still gets 3 (raw share 0.12); never more landmarks than events
+    assert _share_landmarks(300, np.array([10000, 4])).tolist() == [300, 3]
+    assert _share_landmarks(300, np.array([100, 2])).tolist() == [100, 2]
