@@ -23,8 +23,6 @@ do correlated random walks on a torus, and every new pair within r_d is an event
 from __future__ import annotations
 
 import argparse
-import ctypes
-import gc
 import os
 import statistics
 import time
@@ -34,12 +32,12 @@ import numpy as np
 from scipy.sparse.csgraph import dijkstra, shortest_path
 from scipy.spatial import cKDTree
 
+from _measure import run_measured
 from swarmtopo.graph import build_graph
 from swarmtopo.landmarks import SUBSAMPLERS, knn_distances, maxmin
 from swarmtopo.log import EncounterLog
 
 N_LANDMARKS = 500
-_LIBC = ctypes.CDLL("libc.so.6")
 STAGES = ("knn", "picks", "distances")
 
 
@@ -65,29 +63,6 @@ def synthetic_log(n_events, *, n_agents=300, side=500.0, r_d=30.0, speed=40.0, d
         count += len(new)
     t, a, b = (np.concatenate(x)[:n_events] for x in (t, a, b))
     return EncounterLog.from_records(t, a, b, meta={"agent_count": n_agents, "r_d": r_d})
-
-
-def _status_kb(field: str) -> int:
-    with open("/proc/self/status") as status:
-        for line in status:
-            if line.startswith(field + ":"):
-                return int(line.split()[1])
-    raise RuntimeError(f"no {field} in /proc/self/status")
-
-
-def run_measured(fn):
-    """(result, wall seconds, peak bytes above the RSS before the call, CPU seconds)."""
-    # freed memory goes back to the OS first (malloc_trim), so that what the call
-    # allocates must take new pages and shows in the peak
-    gc.collect()
-    _LIBC.malloc_trim(0)
-    with open("/proc/self/clear_refs", "w") as clear:
-        clear.write("5")  # reset the peak RSS (VmHWM) to the current RSS
-    baseline = _status_kb("VmRSS")
-    start, cpu = time.perf_counter(), time.process_time()
-    result = fn()
-    seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
-    return result, seconds, (_status_kb("VmHWM") - baseline) * 1024, cpu
 
 
 class StageClock:

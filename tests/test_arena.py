@@ -1,6 +1,7 @@
 """Arena: validation, true Betti numbers, geometry helpers, generators, GeoJSON."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -18,7 +19,7 @@ from swarmtopo.arena import (
     square_arena,
     two_rooms_arena,
 )
-from swarmtopo.errors import ArenaError, SwarmtopoError
+from swarmtopo.errors import ArenaError, InputError, SwarmtopoError
 from swarmtopo.io import read_arena, write_arena
 
 
@@ -225,7 +226,7 @@ def test_sample_uniform_clearance_is_exact_and_deterministic():
     assert np.array_equal(pts, arena.sample_uniform(50_000, rng=7, clearance=40.0))
     with pytest.raises(ArenaError, match="no free space"):
         arena.sample_uniform(10, rng=1, clearance=200.0)
-    with pytest.raises(ArenaError, match="non-negative integer"):
+    with pytest.raises(InputError, match="number of points must be a non-negative integer"):
         arena.sample_uniform(-1)
 
 
@@ -236,7 +237,7 @@ def test_scaled():
     assert big.area == pytest.approx(4 * arena.area)
     assert big.bounds == (0.0, 0.0, 1000.0, 1000.0)
     for bad in (0, -1.0, float("nan")):
-        with pytest.raises(ArenaError):
+        with pytest.raises(InputError, match="scale factor must be a positive finite number"):
             arena.scaled(bad)
 
 
@@ -333,13 +334,19 @@ def test_impossible_request_raises_a_clear_error():
         random_arena(1, rng=0, scale=2.0, hole_size=400.0, max_tries=50)
 
 
-@pytest.mark.parametrize("kwargs", [
-    {"n_holes": -1}, {"n_holes": 1.5}, {"n_holes": 1, "scale": 0}, {"n_holes": 1, "side": -5},
-    {"n_holes": 1, "shapes": ("hexagon",)}, {"n_holes": 1, "shapes": ()}, {"n_holes": 1, "outer": "circle"},
-    {"n_holes": 1, "clearance": -1.0}, {"n_holes": 1, "hole_size": float("inf")},
+@pytest.mark.parametrize("kwargs, message", [
+    ({"n_holes": -1}, "n_holes must be a non-negative integer"),
+    ({"n_holes": 1.5}, "n_holes must be a non-negative integer"),
+    ({"n_holes": 1, "scale": 0}, "scale must be a positive finite number"),
+    ({"n_holes": 1, "side": -5}, "side must be a positive finite number"),
+    ({"n_holes": 1, "shapes": ("hexagon",)}, "unknown hole shape 'hexagon'"),
+    ({"n_holes": 1, "shapes": ()}, "unknown hole shape None"),
+    ({"n_holes": 1, "outer": "circle"}, "unknown outer wall 'circle'"),
+    ({"n_holes": 1, "clearance": -1.0}, "clearance must be a finite number >= 0"),
+    ({"n_holes": 1, "hole_size": float("inf")}, "hole_size must be a positive finite number"),
 ])
-def test_random_arena_rejects_bad_arguments(kwargs):
-    with pytest.raises(SwarmtopoError):
+def test_random_arena_rejects_bad_arguments(kwargs, message):
+    with pytest.raises(SwarmtopoError, match=re.escape(message)):
         random_arena(**kwargs)
 
 

@@ -176,18 +176,31 @@ def merged(intervals):
     return out
 
 
+def stops_from_status_rows(log: EncounterLog) -> dict[int, list[tuple[float, float]]]:
+    """Stop intervals read literally off the status rows, without log.stop_intervals():
+    per agent in time order, a row saying S starts (or continues) a stop that lasts
+    until the agent's next row, or forever if it has none."""
+    rows = {}
+    for t, agent, state in zip(log.status_t.tolist(), log.status_agent.tolist(), log.status_state.tolist()):
+        rows.setdefault(agent, []).append((t, STATES[state]))
+    stops = {}
+    for agent, seq in rows.items():
+        seq.sort()
+        for (t, state), (t_next, _) in zip(seq, seq[1:] + [(INF, None)]):
+            if state == "S":
+                stops.setdefault(agent, []).append((t, t_next))
+    return stops
+
+
 def networkx_distances(log: EncounterLog, metric: str, window=None) -> np.ndarray:
     """The paper's definition literally: every pair of events sharing an agent."""
     lo, hi = (-INF, INF) if window is None else window
     events = [(float(t), {int(a), int(b)}) for t, a, b in zip(log.t, log.a, log.b) if lo <= t <= hi]
-    stops = {}
-    if metric != "plain":
-        for agent, start, end in zip(*log.stop_intervals()):
-            stops.setdefault(int(agent), []).append((float(start), float(end)))
+    stops = stops_from_status_rows(log) if metric != "plain" else {}
     if metric == "hybrid":
         for agent, time in zip(log.static_agent, log.static_time):
             stops.setdefault(int(agent), []).append((float(time), INF))
-        stops = {k: merged(v) for k, v in stops.items()}
+    stops = {k: merged(v) for k, v in stops.items()}  # consecutive S rows: one stop
     g = nx.Graph()
     g.add_nodes_from(range(len(events)))
     for i, (ti, ai) in enumerate(events):
@@ -213,7 +226,8 @@ def small_logs(draw):
     agent = st.integers(0, n_agents - 1)
     events = draw(st.lists(st.tuples(time, agent, agent).filter(lambda e: e[1] != e[2]), min_size=1,
                            max_size=14, unique_by=lambda e: (e[0], min(e[1:]), max(e[1:]))))
-    status = draw(st.lists(st.tuples(time, agent, st.sampled_from(STATES)), max_size=10))
+    status = draw(st.lists(st.tuples(time, agent, st.sampled_from(STATES)), max_size=10,
+                           unique_by=lambda row: row[:2]))  # one row per agent and time
     static_agents = draw(st.lists(agent, unique=True, max_size=n_agents))
     static_times = [draw(time) for _ in static_agents]
     t, a, b = zip(*events)

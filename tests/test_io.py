@@ -2,6 +2,8 @@
 
 import json
 import time
+from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pyarrow as pa
@@ -13,16 +15,19 @@ from swarmtopo.arena import default_arena
 from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.io import (
     GROUND_TRUTH_FILES,
+    LOG_FORMAT,
+    jsonable,
     read_arena,
     read_json,
     read_log,
     read_trajectories,
     read_truth,
     strip_ground_truth,
+    write_arena,
     write_json,
     write_log,
 )
-from swarmtopo.log import STATES, EncounterLog
+from swarmtopo.log import EncounterLog
 
 FORMATS = ["csv", "parquet"]
 AWKWARD_TIMES = [0.1, 1 / 3, 1e-300, 123456789.12345679, 5e-324, 2.0, 1e22, 0.30000000000000004]
@@ -65,7 +70,9 @@ def test_round_trip(tmp_path, fmt, ids, extras):
     back = read_log(tmp_path)
     assert_same_log(log, back)
     expected_meta = dict(log.meta)
-    if ids != "int":  # IDs other than 0..n-1 are declared explicitly
+    if ids == "int":  # IDs 0..n-1 are declared by their count, others one by one
+        expected_meta["agent_count"] = 6
+    else:
         expected_meta["agent_ids"] = log.agent_ids.tolist()
     assert back.meta == expected_meta
     # a second trip changes nothing
@@ -87,7 +94,7 @@ def test_only_events_is_a_valid_log(tmp_path):
     log = read_log(tmp_path)
     assert log.t.tolist() == [0.25, 0.5] and log.agent_ids.tolist() == [1, 2, 3]
     assert len(log.status_t) == 0 and len(log.static_agent) == 0
-    assert log.meta == {"agent_count": 3}
+    assert log.meta == {} and log.n_agents == 3
 
 
 @pytest.mark.parametrize("fmt", FORMATS)
@@ -111,10 +118,24 @@ def test_meta_json_layout(tmp_path):
     meta = json.loads(text)
     assert text == json.dumps(meta, sort_keys=True, indent=2) + "\n"
     assert meta["static"] == [{"agent": 'say "hi"', "time": 12.25}, {"agent": "é", "time": 10.0}]
-    assert meta["agent_count"] == 6 and meta["agent_ids"] == log.agent_ids.tolist()
+    assert meta["agent_ids"] == log.agent_ids.tolist() and "agent_count" not in meta
     write_log(make_log("int"), tmp_path / "ints")
     meta = read_json(tmp_path / "ints" / "meta.json")
     assert meta["agent_count"] == 6 and "agent_ids" not in meta
+
+
+@pytest.mark.parametrize("ids", ["int", "sparse", "text"])
+def test_the_declaration_written_is_the_logs_agents_whatever_meta_says(tmp_path, ids):
+    log = make_log(ids)
+    # a stale or wrong declaration in log.meta must not reach meta.json
+    stale = replace(log, meta={**log.meta, "agent_count": 99, "agent_ids": ["ghost"]})
+    write_log(stale, tmp_path)
+    meta = read_json(tmp_path / "meta.json")
+    if ids == "int":
+        assert meta["agent_count"] == 6 and "agent_ids" not in meta
+    else:
+        assert meta["agent_ids"] == log.agent_ids.tolist() and "agent_count" not in meta
+    assert_same_log(log, read_log(tmp_path))
 
 
 def test_csv_layout_is_plain(tmp_path):
@@ -258,6 +279,45 @@ def test_ragged_csv_row(tmp_path):
     assert "row 2: cannot parse CSV (Expected 3 columns, got 2" in str(err)
 
 
+@pytest.mark.parametrize("data, fragment", [
+    ("t,a,b\n0,1,2\n".encode("utf-16"), "byte-order mark of UTF-16"),
+    (b"\xff\xfet,a,b\n0,1,2\n", "byte-order mark of UTF-16"),
+    ("t,a,b\n0,1,2\n".encode("utf-32"), "byte-order mark of UTF-32"),
+    (b"t,a,b,not\xe9\n0,1,2,x\n", "the header row holds the byte 0xe9"),
+])
+def test_a_file_that_is_not_utf8_is_named(tmp_path, data, fragment):
+    (tmp_path / "events.csv").write_bytes(data)
+    err = read_error(tmp_path)
+    assert err.file == str(tmp_path / "events.csv")
+    assert "not UTF-8 text" in str(err) and fragment in str(err)
+
+
+def test_a_value_that_is_not_utf8_is_located(tmp_path):
+    # latin-1 "é" in an ID: row 3 of events; in status, a bad byte in a state label
+    (tmp_path / "events.csv").write_bytes(b"t,a,b\n0,1,2\n1,2,3\n2,Jos\xe9,3\n")
+    err = read_error(tmp_path)
+    assert (err.file, err.row, err.column, err.value) == (str(tmp_path / "events.csv"), 3, "a", b"Jos\xe9")
+    assert err.reason == "not UTF-8 text"
+    (tmp_path / "events.csv").write_text("t,a,b\n0,1,2\n")
+    (tmp_path / "status.csv").write_bytes(b"t,agent,state\n0,1,RW\n1,1,\xa7\n")
+    err = read_error(tmp_path)
+    assert (err.file, err.row, err.column) == (str(tmp_path / "status.csv"), 2, "state")
+    # a bad byte in a column read_log ignores is no error
+    (tmp_path / "status.csv").unlink()
+    (tmp_path / "events.csv").write_bytes(b"t,a,b,note\n0,1,2,caf\xe9\n")
+    assert read_log(tmp_path).n_events == 1
+
+
+def test_conflicting_or_repeated_status_rows_are_located(tmp_path):
+    events = "t,a,b\n0,1,2\n"
+    err = read_error(folder(tmp_path, events, status="t,agent,state\n0,1,RW\n2,1,S\n0,2,RW\n2,1,WF\n"))
+    assert (err.file, err.row, err.column, err.value) == (str(tmp_path / "status.csv"), 4, "state", "WF")
+    assert "conflicting status rows: row 2 says agent 1 is S at t=2.0, row 4 says WF" in str(err)
+    err = read_error(folder(tmp_path, events, status="t,agent,state\n0,1,RW\n0.5,2,S\n0.50,2,s\n"))
+    assert (err.file, err.row) == (str(tmp_path / "status.csv"), 3)
+    assert "duplicate status row: row 3 repeats row 2 (t=0.5, agent 2, S)" in str(err)
+
+
 def test_empty_and_missing_files(tmp_path):
     err = read_error(folder(tmp_path, ""))
     assert "cannot parse CSV" in str(err) and err.file == str(tmp_path / "events.csv")
@@ -304,6 +364,15 @@ def test_bad_meta_names_the_file_and_key(tmp_path, meta, fragment):
     err = read_error(folder(tmp_path, "t,a,b\n0,1,2\n", meta=meta))
     assert err.file == str(tmp_path / "meta.json")
     assert fragment in str(err)
+
+
+def test_the_log_format_is_checked_when_declared(tmp_path):
+    folder(tmp_path, "t,a,b\n0,1,2\n", meta=json.dumps({"format": LOG_FORMAT, "version": "9.9"}))
+    assert read_log(tmp_path).meta == {"format": "swarmtopo-log/1", "version": "9.9"}
+    (tmp_path / "meta.json").write_text('{"format": "swarmtopo-log/2"}')
+    err = read_error(tmp_path)
+    assert err.file == str(tmp_path / "meta.json") and err.value == "swarmtopo-log/2"
+    assert "key 'format' is not 'swarmtopo-log/1'" in str(err)
 
 
 def test_bad_static_entry_is_located(tmp_path):
@@ -397,6 +466,44 @@ def test_json_helpers(tmp_path):
     (tmp_path / "bin.json").write_bytes(b'{"a": "\xff"}')
     with pytest.raises(InputError, match="not UTF-8"):
         read_json(tmp_path / "bin.json")
+
+
+def test_jsonable():
+    data = {1: (np.int64(3), np.float32(0.5), np.bool_(False)), "inf": [np.inf, -np.inf, np.nan, 2.5],
+            "array": np.array([[1.0, np.inf], [np.nan, -0.0]]), "path": Path("a") / "b", "none": None}
+    out = jsonable(data)
+    assert out == {"1": [3, 0.5, False], "inf": ["inf", "-inf", None, 2.5],
+                   "array": [[1.0, "inf"], [None, -0.0]], "path": str(Path("a") / "b"), "none": None}
+    assert [type(v) for v in out["1"]] == [int, float, bool]
+    assert json.loads(json.dumps(out, allow_nan=False)) == out  # plain, strict JSON
+    with pytest.raises(TypeError, match="set"):
+        jsonable({"x": {1, 2}})
+
+
+def test_file_system_refusals_name_the_path(tmp_path):
+    log = make_log()
+    taken = tmp_path / "taken"
+    taken.write_text("a file, not a folder")
+    with pytest.raises(InputError) as info:
+        write_log(log, taken)
+    assert info.value.file == str(taken) and "cannot create the output folder (a file of that name exists)" \
+        in str(info.value)
+    with pytest.raises(InputError) as info:
+        write_log(log, taken / "below")
+    assert info.value.file == str(taken / "below") and "cannot create the output folder" in str(info.value)
+    (tmp_path / "log" / "meta.json").mkdir(parents=True)  # a folder where a file goes
+    with pytest.raises(InputError) as info:
+        write_log(log, tmp_path / "log")
+    assert info.value.file == str(tmp_path / "log" / "meta.json") and "cannot write file" in str(info.value)
+    with pytest.raises(InputError) as info:
+        write_json({"a": 1}, taken / "x.json")
+    assert info.value.file == str(taken / "x.json") and "cannot write file" in str(info.value)
+    with pytest.raises(InputError) as info:
+        write_arena(default_arena(), tmp_path / "log" / "meta.json")
+    assert info.value.file == str(tmp_path / "log" / "meta.json")
+    with pytest.raises(InputError, match="cannot read file"):
+        read_json(tmp_path / "log" / "meta.json")
+    assert not list(tmp_path.rglob(".*.tmp"))  # no temporary file is left behind
 
 
 # -- size ------------------------------------------------------------------------------------------

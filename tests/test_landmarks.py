@@ -1,5 +1,6 @@
 """Landmark subsampling: agreement with dense literal versions, theorems, robustness."""
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -302,19 +303,20 @@ def test_disconnected_graph_is_a_clear_error(method):
         SUBSAMPLERS[method](g, 3, k=2, rng=0) if method != "maxmin" else maxmin(g, 3, rng=0)
 
 
-@pytest.mark.parametrize("call", [
-    lambda g: maxmin(g, 0),
-    lambda g: maxmin(g, 2.5),
-    lambda g: knn_maxmin(g, 3, k=0),
-    lambda g: knn_maxmin(g, 3, q=0.0),
-    lambda g: knn_maxmin(g, 3, q=1.5),
-    lambda g: knn_maxmin(g, 3, k=5),  # 5 events: k must be < 5
-    lambda g: probabilistic_maxmin(g, 3, omega=-1.0),
-    lambda g: knn_distances(g, 0),
+@pytest.mark.parametrize("call, message", [
+    (lambda g: maxmin(g, 0), "n_landmarks must be a positive integer"),
+    (lambda g: maxmin(g, 2.5), "n_landmarks must be a positive integer"),
+    (lambda g: knn_maxmin(g, 3, k=0), "k must be a positive integer"),
+    (lambda g: knn_maxmin(g, 3, q=0.0), "q must be a positive finite number"),
+    (lambda g: knn_maxmin(g, 3, q=1.5), "q must be in (0, 1]"),
+    (lambda g: knn_maxmin(g, 3, k=5), "k = 5 nearest neighbours need more than k events"),
+    (lambda g: probabilistic_maxmin(g, 3, omega=-1.0), "omega must be a finite number >= 0"),
+    (lambda g: probabilistic_maxmin(g, 3, omega=float("nan")), "omega must be a finite number >= 0"),
+    (lambda g: knn_distances(g, 0), "k must be a positive integer"),
 ])
-def test_bad_parameters_are_input_errors(call):
+def test_bad_parameters_are_input_errors(call, message):
     g = graph_from_edges(5, [0, 1, 2, 3], [1, 2, 3, 4], np.ones(4))
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match=re.escape(message)):
         call(g)
 
 

@@ -5,7 +5,7 @@ import pyarrow as pa
 import pytest
 
 from swarmtopo.errors import InputError
-from swarmtopo.log import RW, S, STATES, WF, EncounterLog
+from swarmtopo.log import RW, S, WF, EncounterLog, parse_states, state_labels
 
 
 def literal_canonical(t, a, b, declared=None):
@@ -68,7 +68,7 @@ def test_pyarrow_columns_give_the_same_log_as_numpy():
     rng = np.random.default_rng(0)
     st_t = np.sort(rng.uniform(0, 10, 50))
     st_agent = a[:50]
-    st_state = np.array(STATES, dtype=object)[rng.integers(0, 3, 50)]
+    st_state = state_labels(rng.integers(0, 3, 50))
     ref = EncounterLog.from_records(t, a, b, status=(st_t, st_agent, st_state))
     chunked_b = pa.chunked_array([pa.array(b[:7].tolist()), pa.array(b[7:].tolist())])
     arrow = EncounterLog.from_records(
@@ -89,9 +89,14 @@ def test_declared_agents_include_those_that_met_nobody():
     assert log.meta["agent_ids"] == ["z", "y", "x"]
 
 
-def test_meta_gets_the_agent_count():
+def test_meta_is_kept_as_given_and_a_log_rebuilds_from_it():
     log = EncounterLog.from_records([0.0], [4], [9])
-    assert log.meta == {"agent_count": 2}
+    assert log.meta == {} and log.n_agents == 2
+    # rebuilding from the log's own IDs and meta gives the same log (IDs are not 0..n-1)
+    again = EncounterLog.from_records(log.t, log.ids_of(log.a), log.ids_of(log.b), meta=log.meta)
+    assert again.agent_ids.tolist() == [4, 9] and again.a.tolist() == [0] and again.b.tolist() == [1]
+    declared = EncounterLog.from_records([0.0], [0], [1], meta={"agent_count": 3, "r_d": 30.0})
+    assert declared.meta == {"agent_count": 3, "r_d": 30.0} and declared.n_agents == 3
 
 
 # -- located errors ---------------------------------------------------------------------------
@@ -174,6 +179,39 @@ def test_states_are_parsed_leniently_and_unknown_states_located():
     assert (err.file, err.row, err.column, err.value) == ("st.csv", 2, "state", "run")
     err = error_of([0.0], [0], [1], status=([0.0, 1.0], [0, 1], pa.array(["RW", None])))
     assert (err.row, err.column) == (2, "state")
+
+
+@pytest.mark.parametrize("rows, row, message", [
+    # same agent, same time, two states: the log would depend on the row order
+    (([0.0, 1.0, 1.0], ["a", "b", "b"], ["RW", "S", "WF"]), 3,
+     "conflicting status rows: row 2 says agent 'b' is S at t=1.0, row 3 says WF"),
+    (([2.5, 0.0, 2.5], [7, 7, 7], ["WF", "RW", "s"]), 3,
+     "conflicting status rows: row 1 says agent 7 is WF at t=2.5, row 3 says S"),
+    # an exact repeat, found after sorting (rows 1 and 4), states compared after parsing
+    (([3.0, 0.0, 1.0, 3.0], [1, 0, 1, 1], ["S", "RW", "RW", " S"]), 4,
+     "duplicate status row: row 4 repeats row 1 (t=3.0, agent 1, S)"),
+])
+def test_two_status_rows_for_one_agent_at_one_time(rows, row, message):
+    ids = rows[1]
+    err = error_of([0.0], [ids[0]], ["zz" if isinstance(ids[0], str) else 99], status=rows)
+    assert (err.file, err.row) == ("st.csv", row)
+    assert message in str(err)
+
+
+def test_same_time_different_agents_or_same_agent_different_times_are_fine():
+    log = EncounterLog.from_records([0.0], [0], [1], status=([1.0, 1.0, 2.0], [0, 1, 0], ["S", "S", "S"]))
+    assert log.status_state.tolist() == [S, S, S]
+
+
+def test_state_labels_and_parse_states_are_inverse():
+    codes = np.array([RW, WF, S, S, RW], np.int8)
+    labels = state_labels(codes)
+    assert labels.dtype == object and labels.tolist() == ["RW", "WF", "S", "S", "RW"]
+    assert parse_states(labels, "x").tolist() == codes.tolist()
+    assert parse_states(pa.array(labels.tolist()).dictionary_encode(), "x").tolist() == codes.tolist()
+    for bad in ([0, 3], [-1], np.array([0.0, 1.0])):  # -1 must not wrap around to "S"
+        with pytest.raises(InputError, match="state code must be an integer 0 .. 2"):
+            state_labels(np.asarray(bad))
 
 
 def test_static_listed_twice():

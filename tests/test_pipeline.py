@@ -39,7 +39,7 @@ def test_noisy_circle_of_events_gives_one_dominant_h1_bar():
 def test_two_disjoint_rooms_give_two_regions():
     sim = simulate(two_rooms_arena(), 200, 20.0, rng=7)
     tmap = map_encounters(sim.log, MapConfig(**FAST))
-    assert tmap.betti[0] == 2
+    assert tmap.betti == {0: 2, 1: 0}
     assert len(tmap.regions) == 2
     # one infinite H0 bar per region in the union diagram
     assert np.isinf(tmap.diagram[0][:, 1]).sum() == 2
@@ -47,22 +47,26 @@ def test_two_disjoint_rooms_give_two_regions():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("arena, holes", [(default_arena(), 1), (square_arena(), 0)], ids=["one-hole", "no-hole"])
-def test_simulated_arenas_map_to_their_hole_count(arena, holes):
-    """The paper's Fig. "encmds" set-up (200 agents, 20 s), default map options.
+@pytest.mark.parametrize("arena, holes, recorded", [(default_arena(), 1, 15), (square_arena(), 0, 16)],
+                         ids=["one-hole", "no-hole"])
+def test_simulated_arenas_map_to_their_hole_count(arena, holes, recorded):
+    """The paper's Fig. "encmds" set-up (200 agents, 20 s), default map options, at
+    L = 300 and 600 landmarks over seeds 0-9 (never used to choose the rule's tau).
 
-    Measured on seeds 0-19 with the interim cover-radius rule: 18/20 one-hole and
-    19/20 no-hole maps were exact.  On the fixed seeds 0-9 we require at least 8/10
-    (a true rate of 0.9 gives 8 or more in 93% of seed sets; the seeds are fixed, so
-    this test is deterministic and fails only if the pipeline gets worse).
+    Recorded when the interim rule was written (docs/model.md): one-hole 8/10 at
+    L = 300 and 7/10 at L = 600; no-hole 8/10 at both.  The rule's tau was chosen on
+    seeds 1000-1011, where about 9 maps in 10 were right.  beta_0 must always be 1,
+    and beta_1 may not get worse than recorded.  The seeds are fixed, so the test is
+    deterministic.
     """
     right = 0
-    for seed in range(10):
-        sim = simulate(arena, 200, 20.0, rng=seed)
-        tmap = map_encounters(sim.log, MapConfig(seed=seed, **FAST))
-        assert tmap.betti[0] == 1
-        right += tmap.betti[1] == holes
-    assert right >= 8
+    for landmarks in (300, 600):
+        for seed in range(10):
+            sim = simulate(arena, 200, 20.0, rng=seed)
+            tmap = map_encounters(sim.log, MapConfig(seed=seed, landmarks=landmarks, **FAST))
+            assert tmap.betti[0] == 1
+            right += tmap.betti[1] == holes
+    assert right >= recorded
 
 
 def test_same_seed_same_map_and_seed_matters():
@@ -118,10 +122,30 @@ def test_bad_config_is_refused(bad, match):
         map_encounters(ring_log(), MapConfig(**bad))
 
 
-def test_landmark_shares_sum_to_budget_and_respect_sizes():
+def test_landmark_shares_follow_events_with_a_minimum_of_three():
     assert _share_landmarks(300, np.array([1000, 500, 500])).tolist() == [150, 75, 75]
     # largest remainder: 100 * (2/3, 1/3) = 66.67, 33.33 -> 67, 33
     assert _share_landmarks(100, np.array([200, 100])).tolist() == [67, 33]
-    # a tiny region still gets 3 (raw share 0.12); never more landmarks than events
+    # a tiny region still gets 3 (raw share 0.12), so the total may exceed the budget
     assert _share_landmarks(300, np.array([10000, 4])).tolist() == [300, 3]
-    assert _share_landmarks(300, np.array([100, 2])).tolist() == [100, 2]
+
+
+@pytest.mark.parametrize("metric", ["plain", "hybrid"])
+@pytest.mark.parametrize("n_landmarks", [15, 40, 90])
+def test_landmark_diagram_within_twice_the_cover_radius_of_the_full_cloud(metric, n_landmarks):
+    """Theorem: landmarks that are r-dense in the cloud give a Rips diagram within
+    bottleneck distance 2r of the whole cloud's (Chazal, de Silva, Oudot 2014)."""
+    from swarmtopo.graph import build_graph
+    from swarmtopo.landmarks import maxmin
+    from swarmtopo.persistence import bottleneck, rips_persistence
+
+    log = simulate(default_arena(), 150, 8.0, rng=11, static_fraction=0.1).log
+    graph = build_graph(log, metric)
+    n, labels = graph.components()
+    sub = graph.subgraph(np.flatnonzero(labels == np.argmax(np.bincount(labels))))
+    assert 150 < sub.n_nodes < 1500
+    full = rips_persistence(sub.distances_from(np.arange(sub.n_nodes)), maxdim=1).diagram
+    land = maxmin(sub, n_landmarks, rng=0)
+    sample = rips_persistence(land.distances, maxdim=1).diagram
+    for dim in (0, 1):
+        assert bottleneck(full, sample, dim) <= 2 * land.cover_radius + 1e-9

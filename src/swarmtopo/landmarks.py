@@ -41,6 +41,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from . import _kernels
+from ._validate import non_negative, positive, positive_int
 from .errors import InputError, SwarmtopoError
 
 Progress = Callable[[str], None]
@@ -100,7 +101,7 @@ def maxmin(graph, n_landmarks: int, *, rng=None, progress: Progress | None = Non
         for i < j (0-based), and every node is within ``cover_radius`` of L.
     """
     arrays = _GraphArrays.of(graph)
-    n_landmarks = _positive_int(n_landmarks, "n_landmarks")
+    n_landmarks = positive_int("n_landmarks", n_landmarks)
     _check_connected(arrays)
     rng = np.random.default_rng(rng)
     notify = progress or _quiet
@@ -143,11 +144,11 @@ def knn_maxmin(graph, n_landmarks: int, *, k: int = 10, q: float = 0.9, rng=None
         ``threshold`` (tau_{q,k}), ``n_kept`` (nodes in V), ``start``.
     """
     arrays = _GraphArrays.of(graph)
-    n_landmarks = _positive_int(n_landmarks, "n_landmarks")
-    k = _positive_int(k, "k")
-    q = float(q)
-    if not 0.0 < q <= 1.0:
-        raise InputError(f"q must be in (0, 1], got {q!r}")
+    n_landmarks = positive_int("n_landmarks", n_landmarks)
+    k = positive_int("k", k)
+    q = positive("q", q)
+    if q > 1.0:
+        raise InputError("q must be in (0, 1]", value=q)
     _check_connected(arrays)
     rng = np.random.default_rng(rng)
     notify = progress or _quiet
@@ -202,11 +203,9 @@ def probabilistic_maxmin(graph, n_landmarks: int, *, k: int = 10, omega: float =
         ``params``: ``k``, ``omega``, ``start``.
     """
     arrays = _GraphArrays.of(graph)
-    n_landmarks = _positive_int(n_landmarks, "n_landmarks")
-    k = _positive_int(k, "k")
-    omega = float(omega)
-    if not (np.isfinite(omega) and omega >= 0):
-        raise InputError(f"omega must be a finite number >= 0, got {omega!r}")
+    n_landmarks = positive_int("n_landmarks", n_landmarks)
+    k = positive_int("k", k)
+    omega = non_negative("omega", omega)
     _check_connected(arrays)
     rng = np.random.default_rng(rng)
     notify = progress or _quiet
@@ -240,7 +239,7 @@ def knn_distances(graph, k: int) -> np.ndarray:
         +inf where the component holds fewer than k other points.
     """
     arrays = _GraphArrays.of(graph)
-    k = _positive_int(k, "k")
+    k = positive_int("k", k)
     return _kernels.knn_rows(arrays.indptr, arrays.indices, arrays.weights, arrays.multiplicity, k)
 
 
@@ -281,12 +280,6 @@ class _GraphArrays:
             raise InputError(f"multiplicity must have shape ({n},) and entries >= 1")
         return cls(adjacency.indptr.astype(np.int64), adjacency.indices.astype(np.int64),
                    weights, multiplicity)
-
-
-def _positive_int(value, name: str) -> int:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < 1:
-        raise InputError(f"{name} must be a positive integer, got {value!r}")
-    return int(value)
 
 
 def _check_connected(arrays: _GraphArrays) -> None:

@@ -28,6 +28,7 @@ from .errors import InputError
 STATES: tuple[str, ...] = ("RW", "WF", "S")
 """Status codes: index in this tuple.  RW random walk, WF wall following, S stopped."""
 RW, WF, S = 0, 1, 2
+_STATE_LABELS = np.asarray(STATES, dtype=object)
 
 
 @dataclass(frozen=True, eq=False)
@@ -46,8 +47,10 @@ class EncounterLog:
     static_agent, static_time
         Agents commanded to stop for good (int64 codes) and when (float64 s).
     meta
-        Metadata (JSON-able): ``units``, ``r_d``, ``duration``, ``agent_count``,
-        ``seed``, provenance.  Never ground truth.
+        Metadata (JSON-able): ``units``, ``r_d``, ``duration``, ``seed``,
+        provenance, and the declaration ``agent_count`` or ``agent_ids`` if the
+        source gave one (the number of agents is :attr:`n_agents`, whatever meta
+        says).  Never ground truth.
     """
 
     t: np.ndarray
@@ -96,7 +99,8 @@ class EncounterLog:
         ------
         InputError
             Quoting the source, 1-based row, column and value: non-numeric, NaN or
-            negative times, a == b, unknown states, undeclared IDs, duplicate events.
+            negative times, a == b, unknown states, undeclared IDs, duplicate events,
+            two status rows for one agent at one time (conflicting or repeated).
             Unsorted input is sorted, not rejected.
         """
         source = {"events": "events", "status": "status", "static": "meta.json static", **(source or {})}
@@ -109,7 +113,7 @@ class EncounterLog:
         if status is not None:
             st_t = _times(status[0], source["status"], "t")
             st_agent = _factorize_ids(status[1], source["status"], "agent")
-            st_state = _states(status[2], source["status"])
+            st_state = parse_states(status[2], source["status"])
         else:
             st_t, st_agent, st_state = np.empty(0), _IdColumn.empty("", ""), np.empty(0, np.int8)
         if static is not None:
@@ -162,13 +166,13 @@ class EncounterLog:
                              value=f"{t[k]:g}, {agent_ids[lo[k]]}, {agent_ids[hi[k]]}")
 
         st_order = np.lexsort((st_t, cst))
+        _refuse_repeated_status(st_t, cst, st_state, st_order, agent_ids, source["status"])
         if len(csa) != len(np.unique(csa)):
             _, first = np.unique(csa, return_index=True)
             i = int(np.setdiff1d(np.arange(len(csa)), first)[0])
             raise InputError("agent listed as static twice", file=source["static"], row=i + 1,
                              column="agent", value=id_cols[3].value(i))
         sa_order = np.argsort(csa, kind="stable")
-        meta.setdefault("agent_count", int(len(agent_ids)))
         return cls(
             t=t, a=lo, b=hi, agent_ids=agent_ids,
             status_t=st_t[st_order], status_agent=cst[st_order], status_state=st_state[st_order],
@@ -351,8 +355,22 @@ def _checked_text(ids: _IdColumn) -> _IdColumn:
     return ids
 
 
-def _states(values, src) -> np.ndarray:
-    """State strings (RW / WF / S, any case, surrounding blanks ignored) -> int8 codes."""
+def parse_states(values, src) -> np.ndarray:
+    """State labels -> int8 codes into STATES, the one parser of state labels.
+
+    Parameters
+    ----------
+    values
+        Labels RW / WF / S (any case, surrounding blanks ignored): a sequence, numpy
+        array or pyarrow array (dictionary-encoded in C, no per-row Python).
+    src
+        File or source name for error messages.
+
+    Raises
+    ------
+    InputError
+        At the first unknown or missing label, with its 1-based row.
+    """
     if isinstance(values, (pa.Array, pa.ChunkedArray)):
         if isinstance(values, pa.ChunkedArray):
             values = values.combine_chunks()
@@ -372,6 +390,37 @@ def _states(values, src) -> np.ndarray:
         raise InputError(f"unknown state; expected one of {', '.join(STATES)}", file=src,
                          row=i + 1, column="state", value=labels[index[i]])
     return out
+
+
+def state_labels(codes) -> np.ndarray:
+    """int8 codes into STATES -> object array of the labels RW / WF / S."""
+    codes = np.asarray(codes)
+    bad = (codes < 0) | (codes >= len(STATES)) if codes.dtype.kind in "iu" else np.ones(codes.shape, bool)
+    if bad.any():
+        i = int(np.argmax(bad.reshape(-1)))
+        raise InputError(f"state code must be an integer 0 .. {len(STATES) - 1} (one of {', '.join(STATES)})",
+                         row=i + 1, column="state", value=codes.reshape(-1)[i])
+    return _STATE_LABELS[codes]
+
+
+def _refuse_repeated_status(t, agent, state, order, agent_ids, src) -> None:
+    """Two status rows for one agent at one time are either a contradiction or a
+    duplicate; either way the log would depend on row order, so refuse them."""
+    t, agent = t[order], agent[order]
+    repeated = (np.diff(t) == 0) & (np.diff(agent) == 0)
+    if not repeated.any():
+        return
+    k = int(np.argmax(repeated))
+    first, second = int(order[k]), int(order[k + 1])  # lexsort is stable: first < second
+    who = agent_ids[agent[k]]
+    who = int(who) if isinstance(who, np.integer) else who
+    when = float(t[k])
+    s1, s2 = STATES[state[first]], STATES[state[second]]
+    if s1 == s2:
+        raise InputError(f"duplicate status row: row {second + 1} repeats row {first + 1} "
+                         f"(t={when!r}, agent {who!r}, {s1})", file=src, row=second + 1)
+    raise InputError(f"conflicting status rows: row {first + 1} says agent {who!r} is {s1} at t={when!r}, "
+                     f"row {second + 1} says {s2}", file=src, row=second + 1, column="state", value=s2)
 
 
 def _declared_ids(meta) -> np.ndarray | None:

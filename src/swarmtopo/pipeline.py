@@ -10,7 +10,8 @@ Disconnected encounter graphs.  Encounters never cross walls between regions, so
 separate regions give separate graph components; too little data can also split one
 region.  Components are found first.  A component with at least
 ``config.min_region_events`` events counts as a region and is mapped on its own; a
-smaller one is reported as too little data, not as a region.  The diagram of the
+smaller one, or one of fewer than three agents (a pair that kept meeting), is reported
+as too little data, not as a region.  The diagram of the
 whole map is the union of the regions' diagrams -- exactly the Rips diagram of the
 disjoint union (points in different regions are infinitely far apart), so H0 has one
 infinite bar per region.  No inf or NaN ever reaches a persistence backend.
@@ -20,19 +21,27 @@ from __future__ import annotations
 
 import platform
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Callable
 
 import numpy as np
 
 from . import __version__
-from .classify import BettiRule, default_rule
+from .classify import BettiRule, RegionScales, default_rule
 from .embed import Embedding, mds
 from .errors import SwarmtopoError
 from .graph import METRICS, EncounterGraph, build_graph
-from .landmarks import SUBSAMPLERS, Landmarks
+from .io import jsonable
+from .landmarks import SUBSAMPLERS, Landmarks, knn_distances, knn_maxmin, maxmin, probabilistic_maxmin
 from .log import EncounterLog
 from .persistence import Diagram, rips_persistence
+
+
+MIN_REGION_AGENTS = 3
+"""Distinct agents a component needs to count as a region (two agents alone that keep
+meeting say nothing about the arena)."""
+STAGES = ("graph", "landmarks", "persistence", "embedding")
+"""Stage names passed to ``map_encounters``'s progress callback, in order."""
 
 
 @dataclass(frozen=True)
@@ -62,7 +71,7 @@ class MapConfig:
     min_region_events
         Events a graph component needs to count as a region (default 50: below
         that a component is a few agents that met only each other, too little to
-        map).
+        map).  It also needs ``MIN_REGION_AGENTS`` distinct agents.
     embed_dim
         Dimension of the MDS picture: 3, 2, or 0 for no picture (sweeps).
     """
@@ -87,12 +96,15 @@ class MapConfig:
                 f"unknown subsampler {self.subsample!r}; expected one of {', '.join(SUBSAMPLERS)}")
         if self.landmarks < 3:
             raise SwarmtopoError(f"landmarks must be at least 3, got {self.landmarks}")
-        if self.maxdim not in (0, 1, 2):
-            raise SwarmtopoError(f"maxdim must be 0, 1 or 2, got {self.maxdim}")
+        if self.maxdim not in (1, 2):
+            raise SwarmtopoError(f"maxdim must be 1 or 2, got {self.maxdim}")
         if self.embed_dim not in (0, 2, 3):
             raise SwarmtopoError(f"embed_dim must be 0, 2 or 3, got {self.embed_dim}")
         if self.window is not None:
             t0, t1 = self.window
+            for end in (t0, t1):
+                if end is not None and not np.isfinite(end):
+                    raise SwarmtopoError(f"window ends must be finite numbers or None, got {end}")
             if t0 is not None and t1 is not None and t1 < t0:
                 raise SwarmtopoError(f"window end {t1} is before its start {t0}")
         return self
@@ -108,7 +120,10 @@ class RegionMap:
     landmarks: Landmarks
     landmark_events: np.ndarray  # (L,) original log event index of each landmark
     diagram: Diagram
+    scales: RegionScales
+    thresholds: dict[int, float]  # bar-length threshold per dimension n >= 1
     betti: dict[int, int]
+    warnings: list[str]
     embedding: Embedding | None
 
 
@@ -124,37 +139,48 @@ class TopologicalMap:
     diagram: Diagram
     regions: list[RegionMap]
     too_little_data: list[dict[str, int]]
-    thresholds: dict[str, Any]
+    rule: dict[str, Any]
     config: MapConfig
     timings: dict[str, float]
     n_events: int
     n_agents: int
     software: dict[str, str] = field(default_factory=dict)
 
+    @property
+    def warnings(self) -> list[str]:
+        """Reasons to doubt the map, from every region."""
+        return [w for r in self.regions for w in r.warnings]
+
     def to_json(self) -> dict[str, Any]:
         """The map.json document (deaths of infinite bars as null)."""
         return {
             "betti": {str(k): int(v) for k, v in sorted(self.betti.items())},
             "diagrams": self.diagram.to_json(),
-            "thresholds": self.thresholds,
+            "thresholds": {**self.rule, "regions": [
+                {"component": r.component, "length": {str(n): float(v) for n, v in r.thresholds.items()}}
+                for r in self.regions]},
+            "warnings": self.warnings,
             "regions": [
                 {
                     "component": r.component,
                     "events": r.n_events,
                     "agents": r.n_agents,
                     "landmarks": int(len(r.landmarks.nodes)),
-                    "cover_radius": float(r.landmarks.cover_radius),
+                    "cover_radius": float(r.scales.cover_radius),
+                    "knn_scale": float(r.scales.knn),
+                    "thresholds": {str(n): float(v) for n, v in r.thresholds.items()},
                     "betti": {str(k): int(v) for k, v in sorted(r.betti.items())},
                     "diagrams": r.diagram.to_json(),
                     "mds_stress": None if r.embedding is None else float(r.embedding.stress),
+                    "warnings": r.warnings,
                 }
                 for r in self.regions
             ],
             "too_little_data": self.too_little_data,
-            "params": _jsonable(asdict(self.config)),
+            "params": jsonable(asdict(self.config)),
             "log": {"events": self.n_events, "agents": self.n_agents},
             "timings": {k: round(v, 6) for k, v in self.timings.items()},
-            "software": self.software,
+            "software": {**self.software, "persistence_backend": self.diagram.backend},
         }
 
 
@@ -177,7 +203,7 @@ def map_encounters(
         How Betti numbers are read off the diagrams; defaults to
         :func:`swarmtopo.classify.default_rule`.
     progress
-        Optional callable receiving the name of each stage as it starts.
+        Optional callable receiving the name of each stage (``STAGES``) as it starts.
 
     Raises
     ------
@@ -189,7 +215,7 @@ def map_encounters(
     rule = rule or default_rule()
     rng = np.random.default_rng(config.seed)
     say = progress or (lambda stage: None)
-    timings: dict[str, float] = {}
+    timings = dict.fromkeys(STAGES, 0.0)
 
     if log.n_events < 2:
         raise SwarmtopoError(
@@ -198,28 +224,26 @@ def map_encounters(
     t0 = time.perf_counter()
     graph = build_graph(log, config.metric, window=config.window)
     n_comp, labels = graph.components()
+    event_comp = labels[graph.node_of_event]
+    events_per_comp = np.bincount(event_comp, minlength=n_comp)
+    agents_per_comp = _agents_per_component(log, graph.event_index, event_comp, n_comp)
     timings["graph"] = time.perf_counter() - t0
 
-    events_per_comp = np.bincount(labels, weights=graph.multiplicity, minlength=n_comp).astype(np.int64)
-    regions_idx = [c for c in np.argsort(-events_per_comp, kind="stable")
-                   if events_per_comp[c] >= config.min_region_events]
-    small = [c for c in range(n_comp) if events_per_comp[c] < config.min_region_events]
+    is_region = (events_per_comp >= config.min_region_events) & (agents_per_comp >= MIN_REGION_AGENTS)
+    regions_idx = [int(c) for c in np.argsort(-events_per_comp, kind="stable") if is_region[c]]
     if not regions_idx:
         raise SwarmtopoError(
-            f"no connected group of encounters has {config.min_region_events} events or more "
-            f"(largest: {int(events_per_comp.max())} of {graph.n_events} events in {n_comp} groups); "
-            "the log is too short or the agents too few to map: collect more data")
-    budget = _share_landmarks(config.landmarks, events_per_comp[regions_idx])
+            f"no connected group of encounters has {config.min_region_events} events or more among "
+            f"{MIN_REGION_AGENTS} agents or more (largest: {int(events_per_comp.max())} of {graph.n_events} "
+            f"events in {n_comp} groups); the log is too short or the agents too few to map: collect more data")
 
     regions: list[RegionMap] = []
-    region_thresholds: list[dict] = []
-    timings.update(landmarks=0.0, persistence=0.0, embedding=0.0)
-    for comp, n_land in zip(regions_idx, budget):
-        nodes = np.flatnonzero(labels == comp)
-        sub = graph.subgraph(nodes)
+    for comp, n_land in zip(regions_idx, _share_landmarks(config.landmarks, events_per_comp[regions_idx])):
+        sub = graph.subgraph(np.flatnonzero(labels == comp))
         say("landmarks")
         t0 = time.perf_counter()
-        land = _subsample(sub, config, int(n_land), rng)
+        land = _subsample(sub, config, int(min(n_land, sub.n_nodes)), rng)
+        scales = RegionScales(knn=_knn_scale(sub, rule.knn_k), cover_radius=float(land.cover_radius))
         timings["landmarks"] += time.perf_counter() - t0
         say("persistence")
         t0 = time.perf_counter()
@@ -230,35 +254,33 @@ def map_encounters(
         emb = (mds(land.distances, dim=config.embed_dim, rng=rng)
                if config.embed_dim and len(land.nodes) > config.embed_dim else None)
         timings["embedding"] += time.perf_counter() - t0
-        rep = sub.representative_event()
         regions.append(RegionMap(
-            component=int(comp),
+            component=comp,
             n_events=int(events_per_comp[comp]),
-            n_agents=_count_agents(log, sub.event_index),
+            n_agents=int(agents_per_comp[comp]),
             landmarks=land,
-            landmark_events=rep[land.nodes],
+            landmark_events=sub.representative_event()[land.nodes],
             diagram=dgm,
-            betti=rule.betti(dgm, land.cover_radius),
+            scales=scales,
+            thresholds=rule.thresholds(dgm, scales),
+            betti=rule.betti(dgm, scales),
+            warnings=rule.warnings(scales),
             embedding=emb,
         ))
-        region_thresholds.append({"component": int(comp), "cover_radius": float(land.cover_radius),
-                                  "length": {str(n): v for n, v in rule.thresholds(dgm, land.cover_radius).items()}})
 
     betti = {0: len(regions)}
     for n in range(1, config.maxdim + 1):
         betti[n] = sum(r.betti.get(n, 0) for r in regions)
-    event_component = labels[graph.node_of_event]
-    too_little = [
-        {"component": int(c), "events": int(events_per_comp[c]),
-         "agents": _count_agents(log, graph.event_index[event_component == c])}
-        for c in small
-    ]
+    too_little = [{"component": int(c), "events": int(events_per_comp[c]), "agents": int(agents_per_comp[c])}
+                  for c in range(n_comp) if not is_region[c]]
     return TopologicalMap(
         betti=betti,
-        diagram=_union(r.diagram for r in regions),
+        diagram=Diagram(pairs=tuple(np.vstack([r.diagram[n] for r in regions])
+                                    for n in range(config.maxdim + 1)),
+                        backend=regions[0].diagram.backend),
         regions=regions,
         too_little_data=too_little,
-        thresholds={**rule.describe(), "regions": region_thresholds},
+        rule=rule.describe(),
         config=config,
         timings=timings,
         n_events=graph.n_events,
@@ -283,49 +305,41 @@ def software_versions() -> dict[str, str]:
     }
 
 
-def _count_agents(log: EncounterLog, events: np.ndarray) -> int:
-    return int(len(np.union1d(log.a[events], log.b[events])))
+def _agents_per_component(log: EncounterLog, event_index: np.ndarray, event_comp: np.ndarray,
+                          n_comp: int) -> np.ndarray:
+    """Distinct agents among each component's events."""
+    comp = np.concatenate([event_comp, event_comp])
+    agent = np.concatenate([log.a[event_index], log.b[event_index]])
+    pairs = np.unique(comp * np.int64(log.n_agents) + agent)
+    return np.bincount(pairs // log.n_agents, minlength=n_comp)
+
+
+def _knn_scale(graph: EncounterGraph, k: int) -> float:
+    """s: median over distinct events (graph nodes) of the mean distance to their k
+    nearest other nodes (see :mod:`swarmtopo.classify`)."""
+    k = min(k, graph.n_nodes - 1)
+    distinct = replace(graph, multiplicity=np.ones_like(graph.multiplicity))
+    return float(np.median(knn_distances(distinct, k).mean(axis=1)))
 
 
 def _subsample(graph: EncounterGraph, config: MapConfig, n_landmarks: int, rng) -> Landmarks:
-    if config.subsample == "maxmin":
-        return SUBSAMPLERS["maxmin"](graph, n_landmarks, rng=rng)
     if config.subsample == "knn":
-        return SUBSAMPLERS["knn"](graph, n_landmarks, k=config.knn_k, q=config.knn_q, rng=rng)
-    return SUBSAMPLERS["probabilistic"](graph, n_landmarks, k=config.knn_k, omega=config.omega, rng=rng)
+        return knn_maxmin(graph, n_landmarks, k=config.knn_k, q=config.knn_q, rng=rng)
+    if config.subsample == "probabilistic":
+        return probabilistic_maxmin(graph, n_landmarks, k=config.knn_k, omega=config.omega, rng=rng)
+    return maxmin(graph, n_landmarks, rng=rng)
 
 
 def _share_landmarks(total: int, events: np.ndarray) -> np.ndarray:
     """Split ``total`` landmarks between regions in proportion to their events.
 
-    Largest-remainder rounding; every region gets at least 3 and at most its events.
+    Largest-remainder rounding; every region gets at least 3 (so the total can
+    exceed ``total`` by those minimums).  The caller caps each share at the region's
+    number of distinct points.
     """
     events = np.asarray(events, dtype=float)
     raw = total * events / events.sum()
     share = np.floor(raw).astype(np.int64)
     for i in np.argsort(-(raw - share), kind="stable")[: total - share.sum()]:
         share[i] += 1
-    return np.clip(share, 3, events.astype(np.int64))
-
-
-def _union(diagrams) -> Diagram:
-    diagrams = list(diagrams)
-    maxdim = max(d.maxdim for d in diagrams)
-    pairs = []
-    for n in range(maxdim + 1):
-        stacked = np.vstack([d[n] for d in diagrams if n <= d.maxdim] or [np.empty((0, 2))])
-        length = stacked[:, 1] - stacked[:, 0]
-        pairs.append(stacked[np.lexsort((stacked[:, 0], -length))])
-    return Diagram(pairs=tuple(pairs), backend=diagrams[0].backend)
-
-
-def _jsonable(value):
-    if isinstance(value, dict):
-        return {k: _jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, (np.integer,)):
-        return int(value)
-    if isinstance(value, (np.floating,)):
-        return float(value)
-    return value
+    return np.maximum(share, 3)

@@ -6,11 +6,11 @@ reaches :func:`swarmtopo.pipeline.map_encounters`.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
+from .io import write_json
 from .log import EncounterLog
 from .pipeline import TopologicalMap
 
@@ -21,7 +21,7 @@ def write_map_outputs(tmap: TopologicalMap, out_dir: Path, *, log: EncounterLog,
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     written = [out_dir / "map.json", out_dir / "diagram.png"]
-    written[0].write_text(json.dumps(tmap.to_json(), indent=2, allow_nan=False) + "\n")
+    write_json(tmap.to_json(), written[0])
     _diagram_figure(tmap).savefig(written[1], dpi=110)
     if any(r.embedding is not None for r in tmap.regions):
         written.append(out_dir / "cloud.png")
@@ -35,8 +35,8 @@ def _diagram_figure(tmap: TopologicalMap):
     rows = len(tmap.regions)
     fig = new_figure(10, 4.5 * rows)
     axes = fig.subplots(rows, 2, squeeze=False)
-    for (ax_d, ax_b), region, thr in zip(axes, tmap.regions, tmap.thresholds["regions"]):
-        lengths = {int(n): v for n, v in thr["length"].items()}
+    for (ax_d, ax_b), region in zip(axes, tmap.regions):
+        lengths = region.thresholds
         name = f"region {region.component}: " if rows > 1 else ""
         betti = ", ".join(f"beta_{n}={b}" for n, b in sorted(region.betti.items()))
         plot_diagram(region.diagram, ax_d, thresholds=lengths, title=f"{name}persistence diagram ({betti})")

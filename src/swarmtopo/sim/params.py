@@ -25,10 +25,10 @@ and ``tau_exit`` and means "never" (no natural stops, wall following never exits
 
 from __future__ import annotations
 
-import math
 import operator
 from dataclasses import dataclass
 
+from .._validate import fraction, non_negative, positive
 from ..errors import InputError
 
 BEHAVIOURS: tuple[str, ...] = ("free", "RW", "WF", "S", "static")
@@ -41,17 +41,6 @@ NATURAL, PURE_RW, PURE_WF, HOLD, STATIC = range(5)
 
 MIN_WALL_OFFSET_FRACTION = 0.1
 """Wall-follow offset lower bound, as a fraction of r_d (see module docstring)."""
-
-
-def _positive(name: str, value, *, allow_inf: bool = False) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} must be a number", value=value) from None
-    if math.isnan(v) or v <= 0 or (math.isinf(v) and not allow_inf):
-        what = "a positive number (inf allowed: never)" if allow_inf else "a positive finite number"
-        raise InputError(f"{name} must be {what}", value=value)
-    return v
 
 
 @dataclass(frozen=True)
@@ -88,16 +77,10 @@ class MotionParams:
 
     def __post_init__(self):
         for name in ("v_c", "l_star", "v_p", "tau_s", "tau_l"):
-            object.__setattr__(self, name, _positive(f"MotionParams.{name}", getattr(self, name)))
+            object.__setattr__(self, name, positive(f"MotionParams.{name}", getattr(self, name)))
         for name in ("tau_stop", "tau_exit"):
-            object.__setattr__(self, name, _positive(f"MotionParams.{name}", getattr(self, name), allow_inf=True))
-        try:
-            p = float(self.p_sh)
-        except (TypeError, ValueError):
-            p = math.nan
-        if not 0.0 <= p <= 1.0:
-            raise InputError("MotionParams.p_sh must be a probability in [0, 1]", value=self.p_sh)
-        object.__setattr__(self, "p_sh", p)
+            object.__setattr__(self, name, positive(f"MotionParams.{name}", getattr(self, name), allow_inf=True))
+        object.__setattr__(self, "p_sh", fraction("MotionParams.p_sh", self.p_sh))
 
 
 @dataclass(frozen=True)
@@ -120,7 +103,7 @@ class SensingParams:
     log_initial_contacts: bool = True
 
     def __post_init__(self):
-        object.__setattr__(self, "r_d", _positive("SensingParams.r_d", self.r_d))
+        object.__setattr__(self, "r_d", positive("SensingParams.r_d", self.r_d))
         for name in ("walls_block", "log_initial_contacts"):
             if not isinstance(getattr(self, name), bool):
                 raise InputError(f"SensingParams.{name} must be True or False", value=getattr(self, name))
@@ -152,13 +135,7 @@ class Command:
     agents: tuple[int, ...] | None = None
 
     def __post_init__(self):
-        try:
-            t = float(self.time)
-        except (TypeError, ValueError):
-            t = math.nan
-        if not (math.isfinite(t) and t >= 0):
-            raise InputError("Command.time must be a finite time >= 0 s", value=self.time)
-        object.__setattr__(self, "time", t)
+        object.__setattr__(self, "time", non_negative("Command.time", self.time))
         if self.behaviour not in BEHAVIOURS:
             raise InputError(f"unknown command behaviour; expected one of {', '.join(BEHAVIOURS)}",
                              value=self.behaviour)
@@ -166,13 +143,7 @@ class Command:
             raise InputError("a Command needs exactly one of fraction= or agents=",
                              value=f"fraction={self.fraction}, agents={self.agents}")
         if self.fraction is not None:
-            try:
-                f = float(self.fraction)
-            except (TypeError, ValueError):
-                f = math.nan
-            if not 0.0 <= f <= 1.0:
-                raise InputError("Command.fraction must be in [0, 1]", value=self.fraction)
-            object.__setattr__(self, "fraction", f)
+            object.__setattr__(self, "fraction", fraction("Command.fraction", self.fraction))
         else:
             ids = []
             for i in self.agents:

@@ -20,16 +20,18 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
-import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numba.core.registry import CPUDispatcher
 
+from .. import __version__
+from .._validate import fraction, non_negative, positive, positive_int
 from ..arena import Arena
 from ..errors import InputError
-from ..log import STATES, EncounterLog
+from ..io import LOG_FORMAT, jsonable
+from ..log import EncounterLog, state_labels
 from . import commands as _commands
 from . import motion as _motion
 from . import sensing as _sensing
@@ -96,9 +98,11 @@ def simulate(
         Model parameters (paper defaults: v_c, l*, v_p, tau_stop, p_sh, tau_s, tau_l,
         tau_exit; r_d).
     commands : sequence of Command
-        Base-station commands, applied in time order (ties: given order).
+        Base-station commands, applied in time order (ties: given order); none may
+        come after the last step t_K = K dt.
     static_fraction, static_time : float
-        Shortcut for ``Command(static_time, "static", fraction=static_fraction)``.
+        Shortcut for ``Command(static_time, "static", fraction=static_fraction)``
+        (so static_time <= t_K when static_fraction > 0).
     rng : int, Generator or None
         Randomness; an int seed is recorded in ``log.meta["seed"]``.
     truth : bool
@@ -112,6 +116,14 @@ def simulate(
     Returns
     -------
     Simulation
+        ``log.meta`` holds ``format`` (:data:`swarmtopo.io.LOG_FORMAT`), ``version``,
+        ``units``, r_d, v_c, v_p, ``duration`` (t_K), dt, ``agent_count``, ``seed``
+        and ``simulation`` (all parameters; infinities written as ``"inf"``).
+
+    Raises
+    ------
+    InputError
+        On a bad parameter, quoting it; on a command (or static_time) after t_K.
     """
     _check_inputs(arena, n_agents, duration, dt, motion, sensing, commands, static_fraction, static_time,
                   trajectory_every, progress)
@@ -126,7 +138,7 @@ def simulate(
         raise InputError(f"rng must be an int seed, a numpy Generator or None ({exc})", value=rng) from None
 
     n = int(n_agents)
-    n_steps = int(round(duration / dt))
+    n_steps = _n_steps(duration, dt)
     r_d = sensing.r_d
     max_step = max(motion.v_c, motion.v_p) * dt
     walls = _walls.build_wall_grid(arena.boundary_segments, arena.bounds, cell=r_d, reach=r_d + 3 * max_step)
@@ -182,48 +194,52 @@ def _check_inputs(arena, n_agents, duration, dt, motion, sensing, commands, stat
                   trajectory_every, progress) -> None:
     if not isinstance(arena, Arena):
         raise InputError(f"arena must be a swarmtopo Arena, got {type(arena).__name__}")
-    if isinstance(n_agents, bool) or not isinstance(n_agents, (int, np.integer)) or n_agents < 1:
-        raise InputError("n_agents must be an integer >= 1", value=n_agents)
+    positive_int("n_agents", n_agents)
     if not isinstance(motion, MotionParams):
         raise InputError(f"motion must be a MotionParams, got {type(motion).__name__}")
     if not isinstance(sensing, SensingParams):
         raise InputError(f"sensing must be a SensingParams, got {type(sensing).__name__}")
-    for name, value in (("dt", dt), ("duration", duration), ("static_time", static_time)):
-        if not isinstance(value, (int, float, np.integer, np.floating)) or not math.isfinite(value):
-            raise InputError(f"{name} must be a finite number of seconds", value=value)
-    if dt <= 0:
-        raise InputError("dt must be > 0 s", value=dt)
-    if duration < 0 or static_time < 0:
-        raise InputError("duration and static_time must be >= 0 s", value=min(duration, static_time))
+    positive("dt", dt)
+    non_negative("duration", duration)
+    non_negative("static_time", static_time)
     speed = max(motion.v_c, motion.v_p)
     if speed * dt > sensing.r_d / 4:
         raise InputError(
             f"time step too coarse: agents move max(v_c, v_p) * dt = {speed * dt:g} mm per step, more than "
             f"r_d / 4 = {sensing.r_d / 4:g} mm, so contacts and walls could be stepped over; "
             f"use dt <= {sensing.r_d / (4 * speed):g} s", value=dt)
-    if not isinstance(static_fraction, (int, float, np.integer, np.floating)) or not 0 <= static_fraction <= 1:
-        raise InputError("static_fraction must be in [0, 1]", value=static_fraction)
+    fraction("static_fraction", static_fraction)
     for c in commands:
         if not isinstance(c, Command):
             raise InputError(f"commands must be Command objects, got {type(c).__name__}", value=c)
     _commands.check_command_agents(commands, int(n_agents))
-    if trajectory_every is not None and not (isinstance(trajectory_every, (int, float, np.integer, np.floating))
-                                             and trajectory_every > 0 and math.isfinite(trajectory_every)):
-        raise InputError("trajectory_every must be a positive number of seconds or None", value=trajectory_every)
+    end = _end_time(duration, dt)
+    if static_fraction > 0 and round(static_time, TIME_DECIMALS) > end:
+        raise InputError(f"static_time is after the run ends at t = {end:g} s, so no agent would become static",
+                         value=static_time)
+    for c in commands:
+        if round(c.time, TIME_DECIMALS) > end:
+            raise InputError(f"command {c.behaviour!r} at t = {c.time:g} s comes after the run ends at "
+                             f"t = {end:g} s", value=c.time)
+    if trajectory_every is not None:
+        positive("trajectory_every", trajectory_every)
     if progress is not None and not callable(progress):
         raise InputError("progress must be callable or None", value=progress)
 
 
-def _jsonable(value):
-    if isinstance(value, float) and not math.isfinite(value):
-        return str(value)
-    return value
+def _n_steps(duration: float, dt: float) -> int:
+    return int(round(duration / dt))
+
+
+def _end_time(duration: float, dt: float) -> float:
+    """t_K, the time of the last step: commands after it would never be applied."""
+    return round(_n_steps(duration, dt) * dt, TIME_DECIMALS)
 
 
 def _meta(arena, n, n_steps, dt, motion, sensing, commands, static_fraction, static_time, seed) -> dict:
     provenance = {
         "n_agents": n,
-        "motion": {k: _jsonable(v) for k, v in dataclasses.asdict(motion).items()},
+        "motion": dataclasses.asdict(motion),
         "sensing": dataclasses.asdict(sensing),
         "commands": [{"time": c.time, "behaviour": c.behaviour, "fraction": c.fraction,
                       "agents": None if c.agents is None else list(c.agents)} for c in commands],
@@ -231,7 +247,9 @@ def _meta(arena, n, n_steps, dt, motion, sensing, commands, static_fraction, sta
         "static_time": float(static_time),
         "arena_betti": list(arena.betti),
     }
-    return {
+    return jsonable({
+        "format": LOG_FORMAT,
+        "version": __version__,
         "units": {"time": "s", "length": "mm"},
         "r_d": sensing.r_d,
         "v_c": motion.v_c,
@@ -241,7 +259,7 @@ def _meta(arena, n, n_steps, dt, motion, sensing, commands, static_fraction, sta
         "agent_count": n,
         "seed": seed,
         "simulation": provenance,
-    }
+    })
 
 
 def _build_log(events, status, static_agents, static_times, meta):
@@ -253,7 +271,7 @@ def _build_log(events, status, static_agents, static_times, meta):
         t, a, b = np.empty(0), np.empty(0, np.int64), np.empty(0, np.int64)
     st_t = np.concatenate([np.full(len(s[1]), s[0]) for s in status])
     st_agent = np.concatenate([s[1] for s in status])
-    st_state = np.asarray(STATES, dtype=object)[np.concatenate([s[2] for s in status])]
+    st_state = state_labels(np.concatenate([s[2] for s in status]))
     static = None
     if static_agents:
         static = (np.concatenate(static_agents), np.concatenate(static_times))

@@ -1,0 +1,149 @@
+"""The command line as a user meets it: real processes, exit codes, stdout/stderr."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from swarmtopo.io import read_log, strip_ground_truth
+
+
+def run(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "swarmtopo", *map(str, args)], capture_output=True,
+                          text=True, cwd=cwd, timeout=300)
+
+
+def assert_one_line_error(proc, *fragments, code=1):
+    assert proc.returncode == code, proc.stderr
+    assert "Traceback" not in proc.stderr
+    lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1, proc.stderr
+    for fragment in fragments:
+        assert fragment in lines[0], lines[0]
+
+
+@pytest.fixture(scope="module")
+def simulated(tmp_path_factory):
+    out = tmp_path_factory.mktemp("sim") / "log"
+    proc = run("simulate", "--holes", 1, "--agents", 200, "--duration", 20, "--seed", 4, "--truth",
+               "--trajectories", 1.0, "--out", out)
+    assert proc.returncode == 0, proc.stderr
+    return out, proc
+
+
+def test_simulate_writes_the_log_folder(simulated):
+    out, proc = simulated
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["arena.geojson", "events.csv", "meta.json", "status.csv", "trajectories.csv", "truth.csv"]
+    log = read_log(out)
+    assert log.n_agents == 200 and log.n_events > 500
+    assert f"{log.n_events} encounters" in proc.stdout
+
+
+def test_simulate_parquet_has_the_same_events_as_csv(tmp_path, simulated):
+    proc = run("simulate", "--holes", 1, "--agents", 200, "--duration", 20, "--seed", 4, "--format", "parquet",
+               "--out", tmp_path / "pq", "--quiet")
+    assert proc.returncode == 0 and proc.stdout == ""
+    a, b = read_log(simulated[0]), read_log(tmp_path / "pq")
+    assert np.array_equal(a.t, b.t) and np.array_equal(a.a, b.a) and np.array_equal(a.b, b.b)
+
+
+def test_map_writes_map_json_and_figures(tmp_path, simulated):
+    proc = run("map", simulated[0], "--out", tmp_path / "m", "--landmarks", 200)
+    assert proc.returncode == 0, proc.stderr
+    doc = json.loads((tmp_path / "m" / "map.json").read_text())
+    assert set(doc) >= {"betti", "diagrams", "params", "timings", "thresholds", "software"}
+    assert doc["betti"]["0"] == 1
+    assert doc["params"]["landmarks"] == 200
+    assert f"beta_1 = {doc['betti']['1']}" in proc.stdout
+    # infinite bars are written as null, one per region
+    assert [d for _, d in doc["diagrams"]["0"]].count(None) == doc["betti"]["0"]
+    assert (tmp_path / "m" / "diagram.png").stat().st_size > 10_000
+    assert (tmp_path / "m" / "cloud.png").stat().st_size > 10_000
+
+
+def test_map_never_reads_ground_truth(tmp_path, simulated):
+    stripped = tmp_path / "stripped"
+    strip_ground_truth(simulated[0], stripped)
+    docs = []
+    # keep only what a real deployment's meta.json may declare: no r_d, speeds, dt, seed
+    meta = json.loads((stripped / "meta.json").read_text())
+    (stripped / "meta.json").write_text(json.dumps({k: meta[k] for k in ("agent_count", "static", "units")}))
+    for src, out in ((simulated[0], tmp_path / "full"), (stripped, tmp_path / "bare")):
+        assert run("map", src, "--out", out, "--quiet").returncode == 0
+        doc = json.loads((out / "map.json").read_text())
+        doc.pop("timings")
+        docs.append(doc)
+    assert docs[0] == docs[1]
+
+
+def test_demo_prints_recovered_and_true_betti_numbers(tmp_path):
+    proc = run("demo", "--out", tmp_path / "demo")
+    assert proc.returncode == 0, proc.stderr
+    assert "recovered: beta_0 = 1, beta_1 =" in proc.stdout
+    assert "true:      beta_0 = 1, beta_1 = 1" in proc.stdout
+    assert (tmp_path / "demo" / "map.json").exists() and (tmp_path / "demo" / "log" / "events.csv").exists()
+
+
+def test_bad_events_file_is_one_line_naming_file_row_column_value(tmp_path):
+    folder = tmp_path / "bad"
+    folder.mkdir()
+    (folder / "events.csv").write_text("t,a,b\n1.0,1,2\n2.0,2,3\nsoon,3,4\n")
+    assert_one_line_error(run("map", folder), "events.csv", "row 3", "'t'", "soon")
+
+
+def test_non_finite_window_is_refused_or_open(simulated, tmp_path):
+    proc = run("map", simulated[0], "--window", "nan:5", "--out", tmp_path / "n")
+    assert proc.returncode == 2 and "NaN" in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+    proc = run("map", simulated[0], "--window", "0:inf", "--out", tmp_path / "i", "--quiet")
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads((tmp_path / "i" / "map.json").read_text())["params"]["window"] == [0.0, None]
+
+
+def test_broken_ground_truth_costs_a_warning_not_the_map(simulated, tmp_path):
+    import shutil
+
+    folder = tmp_path / "log"
+    shutil.copytree(simulated[0], folder)
+    (folder / "arena.geojson").write_text("{}")
+    truth = (folder / "truth.csv").read_text().splitlines()
+    (folder / "truth.csv").write_text("\n".join(truth[:-5]) + "\n")
+    proc = run("map", folder, "--out", tmp_path / "m")
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stderr.startswith("warning: ground truth ignored") and "Traceback" not in proc.stderr
+    assert (tmp_path / "m" / "map.json").exists() and (tmp_path / "m" / "cloud.png").exists()
+
+
+def test_out_that_is_a_file_is_one_line(simulated, tmp_path):
+    target = tmp_path / "file"
+    target.write_text("x")
+    assert_one_line_error(run("map", simulated[0], "--out", target), str(target))
+
+
+def test_missing_folder_is_one_line(tmp_path):
+    assert_one_line_error(run("map", tmp_path / "nowhere"), "nowhere")
+
+
+def test_overlapping_holes_arena_is_one_line(tmp_path):
+    arena = {"type": "Polygon", "coordinates": [
+        [[0, 0], [500, 0], [500, 500], [0, 500], [0, 0]],
+        [[100, 100], [200, 100], [200, 200], [100, 200], [100, 100]],
+        [[150, 150], [250, 150], [250, 250], [150, 250], [150, 150]]]}
+    path = tmp_path / "arena.geojson"
+    path.write_text(json.dumps(arena))
+    assert_one_line_error(run("simulate", "--arena", path, "--out", tmp_path / "o"), "arena.geojson", "overlap")
+
+
+def test_bad_option_values(simulated, tmp_path):
+    assert_one_line_error(run("map", simulated[0], "--out", tmp_path / "x", "--metric", "euclid"),
+                          "unknown metric 'euclid'")
+    assert_one_line_error(run("map", simulated[0], "--window", "abc"), "T0:T1", code=2)
+    assert_one_line_error(run("simulate", "--format", "xml", "--out", tmp_path / "y"), "xml", code=2)
+
+
+@pytest.mark.parametrize("command", ["simulate", "map", "demo"])
+def test_help_shows_an_example(command):
+    proc = run(command, "--help")
+    assert proc.returncode == 0 and "Example: swarmtopo" in proc.stdout
