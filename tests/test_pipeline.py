@@ -149,3 +149,20 @@ def test_landmark_diagram_within_twice_the_cover_radius_of_the_full_cloud(metric
     sample = rips_persistence(land.distances, maxdim=1).diagram
     for dim in (0, 1):
         assert bottleneck(full, sample, dim) <= 2 * land.cover_radius + 1e-9
+
+
+def test_automatic_landmarks_are_the_shortest_prefix_meeting_the_guarantee():
+    from swarmtopo.classify import default_rule
+
+    log = simulate(default_arena(), 200, 20.0, rng=5).log
+    auto = map_encounters(log, MapConfig(seed=1, **FAST)).regions[0]
+    rule = default_rule()
+    limit = rule.max_cover_radius(auto.scales.knn)
+    n = len(auto.landmarks.nodes)
+    assert auto.landmarks.cover_radius <= limit and auto.warnings == []
+    assert auto.landmarks.cover_radii[n - 2] > limit  # one fewer would not do
+    # greedy selection: the same first n landmarks as an explicit run with L = n
+    fixed = map_encounters(log, MapConfig(seed=1, landmarks=n, **FAST)).regions[0]
+    assert np.array_equal(fixed.landmarks.nodes, auto.landmarks.nodes)
+    assert np.array_equal(fixed.landmarks.distances, auto.landmarks.distances)
+    assert fixed.betti == auto.betti

@@ -19,8 +19,9 @@ H0: it is the number of encounter-graph components with enough events (see
 0 (a static agent's stop) count once, else s could collapse to 0.
 
 The landmarks' diagram is within bottleneck 2 r_cover of the whole cloud's, so the
-rule is only trustworthy when 4 r_cover <= tau * s; :meth:`LocalScaleRule.warnings`
-says so otherwise (too few landmarks).
+rule is only trustworthy when 4 r_cover <= tau * s (:meth:`LocalScaleRule.max_cover_radius`):
+the pipeline's automatic landmark count picks landmarks until it holds, and
+:meth:`LocalScaleRule.warnings` says when it does not (too few landmarks).
 
 tau was chosen on tuning seeds 1000-1011 (500 mm square, one centred hole or none,
 200 agents, 20 s, hybrid metric, maxmin, L in {300, 600, all events}, 0 and 5 % static
@@ -63,6 +64,8 @@ class BettiRule(Protocol):
 
     def warnings(self, scales: RegionScales) -> list[str]: ...
 
+    def max_cover_radius(self, knn_scale: float) -> float: ...
+
     def describe(self) -> dict: ...
 
 
@@ -82,9 +85,13 @@ class LocalScaleRule:
         return {n: int(np.count_nonzero(diagram.lengths(n) > limit))
                 for n, limit in self.thresholds(diagram, scales).items()}
 
+    def max_cover_radius(self, knn_scale: float) -> float:
+        """Largest covering radius for which the sampling guarantee holds: tau s / 4."""
+        return self.tau * knn_scale / 4
+
     def warnings(self, scales: RegionScales) -> list[str]:
         """Why the answer may be unreliable (empty when it is not)."""
-        if 4 * scales.cover_radius > self.tau * scales.knn:
+        if scales.cover_radius > self.max_cover_radius(scales.knn):
             return [f"landmarks too sparse: covering radius {scales.cover_radius:.3g} s exceeds "
                     f"{self.tau / 4:g} x the cloud's k-NN scale {scales.knn:.3g} s, so subsampling noise "
                     "can pass the threshold; use more landmarks"]

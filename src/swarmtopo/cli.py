@@ -107,7 +107,9 @@ def map_command(
     out_dir: Optional[Path] = typer.Option(None, "--out", help="Output folder (default: LOG_DIR/map)."),
     metric: str = typer.Option("hybrid", "--metric", help="plain | contracted | hybrid (paper's metrics)."),
     subsample: str = typer.Option("maxmin", "--subsample", help="maxmin | knn | probabilistic."),
-    landmarks: int = typer.Option(300, "--landmarks", help="Number of landmarks L."),
+    landmarks: Optional[int] = typer.Option(
+        None, "--landmarks", min=3,
+        help="Number of landmarks L (default: the fewest that meet the sampling guarantee, at most 1000)."),
     window: Optional[str] = typer.Option(None, "--window", callback=_parse_window,
                                          help="Time window T0:T1 in seconds (either end may be empty)."),
     maxdim: int = typer.Option(1, "--maxdim", min=1, max=2, help="Highest homology dimension (1 or 2)."),

@@ -40,6 +40,8 @@ from .persistence import Diagram, rips_persistence
 MIN_REGION_AGENTS = 3
 """Distinct agents a component needs to count as a region (two agents alone that keep
 meeting say nothing about the arena)."""
+AUTO_LANDMARKS_MAX = 1000
+"""Most landmarks the automatic count takes per region (persistence stays ~1 s)."""
 STAGES = ("graph", "landmarks", "persistence", "embedding")
 """Stage names passed to ``map_encounters``'s progress callback, in order."""
 
@@ -59,7 +61,10 @@ class MapConfig:
         ``probabilistic`` (probabilistic maxmin).
     landmarks
         Number of landmarks L for the whole map, shared between regions in
-        proportion to their events.
+        proportion to their events.  None (default): per region, the fewest
+        landmarks whose covering radius meets the Betti rule's sampling guarantee
+        (``rule.max_cover_radius``), at most ``AUTO_LANDMARKS_MAX``; maxmin-type
+        selection is greedy, so these are the first landmarks of a longer run.
     window
         Optional time window (t0, t1) on the events, seconds; None = whole log.
     maxdim
@@ -78,7 +83,7 @@ class MapConfig:
 
     metric: str = "hybrid"
     subsample: str = "maxmin"
-    landmarks: int = 300
+    landmarks: int | None = None
     window: tuple[float | None, float | None] | None = None
     maxdim: int = 1
     seed: int | None = 0
@@ -94,7 +99,7 @@ class MapConfig:
         if self.subsample not in SUBSAMPLERS:
             raise SwarmtopoError(
                 f"unknown subsampler {self.subsample!r}; expected one of {', '.join(SUBSAMPLERS)}")
-        if self.landmarks < 3:
+        if self.landmarks is not None and self.landmarks < 3:
             raise SwarmtopoError(f"landmarks must be at least 3, got {self.landmarks}")
         if self.maxdim not in (1, 2):
             raise SwarmtopoError(f"maxdim must be 1 or 2, got {self.maxdim}")
@@ -237,13 +242,20 @@ def map_encounters(
             f"{MIN_REGION_AGENTS} agents or more (largest: {int(events_per_comp.max())} of {graph.n_events} "
             f"events in {n_comp} groups); the log is too short or the agents too few to map: collect more data")
 
+    shares = (_share_landmarks(config.landmarks, events_per_comp[regions_idx]) if config.landmarks
+              else [None] * len(regions_idx))
     regions: list[RegionMap] = []
-    for comp, n_land in zip(regions_idx, _share_landmarks(config.landmarks, events_per_comp[regions_idx])):
+    for comp, n_land in zip(regions_idx, shares):
         sub = graph.subgraph(np.flatnonzero(labels == comp))
         say("landmarks")
         t0 = time.perf_counter()
-        land = _subsample(sub, config, int(min(n_land, sub.n_nodes)), rng)
-        scales = RegionScales(knn=_knn_scale(sub, rule.knn_k), cover_radius=float(land.cover_radius))
+        knn_scale = _knn_scale(sub, rule.knn_k)
+        if n_land is None:
+            land = _subsample(sub, config, min(AUTO_LANDMARKS_MAX, sub.n_nodes), rng)
+            land = _first_covering(land, rule.max_cover_radius(knn_scale))
+        else:
+            land = _subsample(sub, config, int(min(n_land, sub.n_nodes)), rng)
+        scales = RegionScales(knn=knn_scale, cover_radius=float(land.cover_radius))
         timings["landmarks"] += time.perf_counter() - t0
         say("persistence")
         t0 = time.perf_counter()
@@ -328,6 +340,16 @@ def _subsample(graph: EncounterGraph, config: MapConfig, n_landmarks: int, rng) 
     if config.subsample == "probabilistic":
         return probabilistic_maxmin(graph, n_landmarks, k=config.knn_k, omega=config.omega, rng=rng)
     return maxmin(graph, n_landmarks, rng=rng)
+
+
+def _first_covering(land: Landmarks, radius: float) -> Landmarks:
+    """The first landmarks of a greedy run whose covering radius is <= ``radius``
+    (all of them if none is; at least 3)."""
+    within = np.flatnonzero(land.cover_radii <= radius)
+    n = max(int(within[0]) + 1, 3) if len(within) else len(land.nodes)
+    n = min(n, len(land.nodes))
+    return replace(land, nodes=land.nodes[:n], distances=land.distances[:n, :n],
+                   cover_radius=float(land.cover_radii[n - 1]), cover_radii=land.cover_radii[:n])
 
 
 def _share_landmarks(total: int, events: np.ndarray) -> np.ndarray:
