@@ -11,10 +11,11 @@ target at the measured event rate (0.39 events per agent-second at 200 agents,
 0.44 at 2,000: walls cost encounters, and small arenas have more wall per area), plus
 a margin.  The log is then cut at the time of its ``n_events``-th event (events and
 status changes after it dropped), so it holds the target number of events (a few more
-when several events share that time step).  A 10^6-event log takes about 30 s to
+when several events share that time step).  A 10^6-event log takes 13-18 s to
 simulate; it is written once with ``swarmtopo.io.write_log(fmt="parquet")`` under
 ``$SWARMTOPO_BENCH_CACHE`` (default ``~/.cache/swarmtopo-bench``), in a folder named
-after every parameter and the swarmtopo version, and read back afterwards.
+after every parameter and a hash of the simulator's source (``swarmtopo/sim/*.py``
+and ``arena.py``: a changed model gives a new log), and read back afterwards.
 
 ``landmark_matrices(sizes, seed)``: the maxmin landmark distance matrices the pipeline
 gives persistence, on the hybrid metric of a simulated two-hole log.
@@ -22,6 +23,7 @@ gives persistence, on the hybrid metric of a simulated two-hole log.
 
 from __future__ import annotations
 
+import hashlib
 import math
 import os
 import shutil
@@ -31,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from swarmtopo import __version__
+import swarmtopo
 from swarmtopo.arena import random_arena
 from swarmtopo.graph import build_graph
 from swarmtopo.io import read_log, write_log
@@ -51,6 +53,15 @@ def cache_dir() -> Path:
     return Path(os.environ.get("SWARMTOPO_BENCH_CACHE", Path.home() / ".cache" / "swarmtopo-bench"))
 
 
+def simulator_fingerprint() -> str:
+    """Short hash of the simulator's source files (the model that makes the logs)."""
+    package = Path(swarmtopo.__file__).parent
+    digest = hashlib.sha256()
+    for path in sorted(package.joinpath("sim").glob("*.py")) + [package / "arena.py"]:
+        digest.update(path.read_bytes())
+    return digest.hexdigest()[:10]
+
+
 def agents_for(n_events: int) -> int:
     """Swarm size for a log of about ``n_events`` events: 2 sqrt(n_events), at least 200."""
     return max(200, int(round(2 * math.sqrt(n_events), -1)))
@@ -60,7 +71,7 @@ def simulated_log_dir(n_events: int, *, holes: int = 2, seed: int = 0,
                       static_fraction: float = STATIC_FRACTION) -> Path:
     """The cached log folder of :func:`simulated_log` (simulated and written on first use)."""
     n_agents = agents_for(n_events)
-    folder = cache_dir() / (f"v{__version__}-events{n_events}-holes{holes}-agents{n_agents}"
+    folder = cache_dir() / (f"sim{simulator_fingerprint()}-events{n_events}-holes{holes}-agents{n_agents}"
                             f"-static{static_fraction:g}-seed{seed}")
     if (folder / "meta.json").is_file():
         return folder

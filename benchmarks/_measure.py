@@ -12,7 +12,9 @@ import ctypes
 import gc
 import os
 import platform
+import subprocess
 import time
+from pathlib import Path
 
 _LIBC = ctypes.CDLL("libc.so.6")
 
@@ -49,3 +51,12 @@ def machine() -> str:
                 model = line.split(":", 1)[1].strip()
                 break
     return f"{model}, {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}"
+
+
+def revision() -> str:
+    """``git describe --always --dirty`` of the repository holding this script."""
+    try:
+        return subprocess.run(["git", "describe", "--always", "--dirty"], cwd=Path(__file__).parent,
+                              capture_output=True, text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown (not a git checkout)"

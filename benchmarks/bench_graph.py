@@ -27,7 +27,7 @@ import tracemalloc
 import numpy as np
 
 from _data import simulated_log
-from _measure import machine, run_measured
+from _measure import machine, revision, run_measured
 from swarmtopo.graph import METRICS, build_graph, literal_distances
 
 REPEATS = 3
@@ -104,7 +104,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="10^5 events; N = 1,000 and 2,000")
     args = parser.parse_args()
-    print(f"machine: {machine()}")
+    print(f"machine: {machine()}; swarmtopo {revision()}")
     for metric in METRICS:  # load the numba kernels (compiled or cached) before timing
         build_graph(simulated_log(1000), metric)
     large_scale(10**5 if args.quick else 10**6)

@@ -6,7 +6,8 @@ simulated two-hole log (``_data.simulated_log``: 2,000 agents at the paper's den
 embed_dim=0)`` for the three subsamplers, on the plain and the hybrid metric (the
 pipeline's default).  One run each, after a warm-up that loads the numba kernels.
 Wall time split as ``TopologicalMap.timings`` reports it (graph incl. components /
-landmarks / persistence; "other" is the rest: region bookkeeping, Betti rule), total
+landmarks incl. the Betti rule's k-NN scale / persistence; "other" is the rest:
+region bookkeeping, Betti rule), total
 wall and CPU time, and peak memory: the process's peak RSS above its RSS before the
 call (``_measure.run_measured``), the log itself not counted.  Targets: maxmin < 60 s
 and < 4 GB; knn and probabilistic < 120 s (and < 4 GB).
@@ -32,7 +33,7 @@ import numba
 import numpy as np
 
 from _data import simulated_log
-from _measure import machine, run_measured
+from _measure import machine, revision, run_measured
 from bench_landmarks import dense_maxmin
 from swarmtopo.graph import build_graph
 from swarmtopo.landmarks import SUBSAMPLERS, maxmin
@@ -110,7 +111,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="10^5 events instead of 10^6")
     args = parser.parse_args()
-    print(f"machine: {machine()}; {numba.get_num_threads()} numba threads")
+    print(f"machine: {machine()}; {numba.get_num_threads()} numba threads; swarmtopo {revision()}")
     warm_up()
     whole_map(10**5 if args.quick else 10**6)
     against_dense(10**4)

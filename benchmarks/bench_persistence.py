@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 from _data import landmark_matrices
-from _measure import machine
+from _measure import machine, revision
 from swarmtopo.persistence import available_backends, rips_persistence
 
 SIZES = (150, 300, 500, 1000, 2000)
@@ -52,7 +52,7 @@ def main():
     backends = available_backends()
     default = rips_persistence(np.zeros((1, 1))).backend
 
-    print(f"machine: {machine()}")
+    print(f"machine: {machine()}; swarmtopo {revision()}")
     start = time.perf_counter()
     matrices = landmark_matrices(sizes, seed=SEED)
     print(f"maxmin landmark matrices (hybrid metric, simulated 2-hole log, 10^5 events) "

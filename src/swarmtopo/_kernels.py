@@ -21,9 +21,8 @@ from numba import get_num_threads, njit, prange
 
 
 @njit(cache=True)
-def _heap_push(keys, nodes, size, key, node):
-    """Insert (key, node) into the binary min-heap ``keys[:size]``; return the new size."""
-    i = size
+def _sift_up(keys, nodes, i, key, node):
+    """Place (key, node) at the hole ``i`` of the binary min-heap, moving it rootwards."""
     while i > 0:
         parent = (i - 1) >> 1
         if keys[parent] <= key:
@@ -33,6 +32,12 @@ def _heap_push(keys, nodes, size, key, node):
         i = parent
     keys[i] = key
     nodes[i] = node
+
+
+@njit(cache=True)
+def _heap_push(keys, nodes, size, key, node):
+    """Insert (key, node) into the binary min-heap ``keys[:size]``; return the new size."""
+    _sift_up(keys, nodes, size, key, node)
     return size + 1
 
 
@@ -57,15 +62,7 @@ def _heap_pop(keys, nodes, size):
         keys[i] = keys[child]
         nodes[i] = nodes[child]
         i = child
-    while i > 0:
-        parent = (i - 1) >> 1
-        if keys[parent] <= key:
-            break
-        keys[i] = keys[parent]
-        nodes[i] = nodes[parent]
-        i = parent
-    keys[i] = key
-    nodes[i] = node
+    _sift_up(keys, nodes, i, key, node)
     return size
 
 
@@ -121,6 +118,44 @@ def settle(indptr, indices, weights, source, limit, count, stop_count,
     return n_found
 
 
+@njit(cache=True)
+def lower_distances(indptr, indices, weights, source, to_set, dist, touched, heap_keys, heap_nodes):
+    """Lower ``to_set[x]`` to d(source, x) wherever that is smaller, in place.
+
+    ``to_set`` holds d(x, L) for a landmark set L; ``source`` joins L.  The search
+    expands a node v only while d(source, v) < to_set[v]: past such a v nothing can
+    improve, since d(source, x) = d(source, v) + d(v, x) >= d(v, L) + d(v, x) >= d(x, L)
+    (triangle inequality).  So it is exact and touches only the new landmark's
+    Voronoi cell -- on hub-heavy graphs (static agents) a few nodes instead of most
+    of the graph.  Scratch arrays as in :func:`settle`.  Returns the nodes settled.
+    """
+    dist[source] = 0.0
+    touched[0] = source
+    n_touched = 1
+    settled = 0
+    size = _heap_push(heap_keys, heap_nodes, 0, 0.0, source)
+    while size > 0:
+        d = heap_keys[0]
+        u = heap_nodes[0]
+        size = _heap_pop(heap_keys, heap_nodes, size)
+        if d > dist[u]:
+            continue
+        to_set[u] = d
+        settled += 1
+        for e in range(indptr[u], indptr[u + 1]):
+            v = indices[e]
+            nd = d + weights[e]
+            if nd < dist[v] and nd < to_set[v]:
+                if dist[v] == np.inf:
+                    touched[n_touched] = v
+                    n_touched += 1
+                dist[v] = nd
+                size = _heap_push(heap_keys, heap_nodes, size, nd, v)
+    for i in range(n_touched):
+        dist[touched[i]] = np.inf
+    return settled
+
+
 class Searcher:
     """Scratch arrays for repeated :func:`settle` calls on one graph (single thread)."""
 
@@ -141,6 +176,11 @@ class Searcher:
                          self.count_all, np.iinfo(np.int64).max, self.dist, self.touched,
                          self.heap_keys, self.heap_nodes, self.found_node, self.found_dist)
         return self.found_node[:n_found], self.found_dist[:n_found]
+
+    def add_landmark(self, source: int, to_set: np.ndarray) -> int:
+        """Lower ``to_set`` (d(x, L), all nodes) for L + {source}; see :func:`lower_distances`."""
+        return lower_distances(self.indptr, self.indices, self.weights, source, to_set, self.dist,
+                               self.touched, self.heap_keys, self.heap_nodes)
 
 
 @njit(cache=True, parallel=True)

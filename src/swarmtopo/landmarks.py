@@ -315,26 +315,27 @@ def _density_rank(mean_knn: np.ndarray, multiplicity: np.ndarray) -> np.ndarray:
 
 def _pick(arrays: _GraphArrays, candidates: np.ndarray, n_landmarks: int, start: int,
           bonus: Callable[[float], np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Sequential landmark picks with radius-bounded searches.
+    """Sequential landmark picks.
 
-    ``u`` holds d(x, L) on the candidates and -inf elsewhere, so non-candidates never
-    win an argmax nor count in the covering radius r = max u.  The next landmark is
-    argmax u (maxmin) or argmax u + bonus(r) over non-landmarks.  Returns the
-    landmark nodes and the covering radius after each pick.  The graph must be connected.
+    ``to_set`` holds d(x, L) for every node; each new landmark lowers it with a search
+    that stops where it cannot improve (exact; see :func:`_kernels.lower_distances`).
+    ``u`` is d(x, L) on the candidates and -inf elsewhere, so non-candidates never win
+    an argmax nor count in the covering radius r = max u.  The next landmark is argmax
+    u (maxmin) or argmax u + bonus(r) over non-landmarks.  Returns the landmark nodes
+    and the covering radius after each pick.  The graph must be connected.
     """
     n_landmarks = min(n_landmarks, int(candidates.sum()))
     search = _kernels.Searcher(arrays.indptr, arrays.indices, arrays.weights)
-    u = np.where(candidates, np.inf, -np.inf)
+    to_set = np.full(arrays.n, np.inf)
     is_landmark = np.zeros(arrays.n, bool)
     nodes = np.empty(n_landmarks, np.int64)
     radii = np.empty(n_landmarks)
-    landmark, radius = start, np.inf
+    landmark = start
     for i in range(n_landmarks):
         nodes[i] = landmark
         is_landmark[landmark] = True
-        # only nodes closer to the new landmark than the current radius can change
-        reached, dist = search.ball(landmark, radius)
-        u[reached] = np.minimum(u[reached], dist)
+        search.add_landmark(landmark, to_set)
+        u = np.where(candidates, to_set, -np.inf)
         radius = radii[i] = u.max()
         if i + 1 == n_landmarks:
             break
