@@ -163,25 +163,30 @@ def dense_maxmin(graph, n_landmarks, start):
     return np.array(chosen), d[np.ix_(chosen, chosen)]
 
 
-def against_dense(n_events, repeats=3):
-    graph = build_graph(synthetic_log(n_events, rng=2), "plain")
+def compare_with_dense(graph, heading: str, repeats: int = 3) -> None:
+    """maxmin (bounded searches + L x L) against dense_maxmin on ``graph``, side by side:
+    checks they pick the same landmarks and distances, prints wall, CPU and memory."""
     ours = [run_measured(lambda: maxmin(graph, N_LANDMARKS, rng=0)) for _ in range(repeats)]
     start = int(ours[0][0].nodes[0])
     dense = [run_measured(lambda: dense_maxmin(graph, N_LANDMARKS, start)) for _ in range(repeats)]
-    (nodes, distances) = dense[0][0]
+    nodes, distances = dense[0][0]
     np.testing.assert_array_equal(ours[0][0].nodes, nodes)
     np.testing.assert_allclose(ours[0][0].distances, distances, rtol=1e-12)
-    t_ours, t_dense = (statistics.median(r[1] for r in runs) for runs in (ours, dense))
-    m_ours, m_dense = (statistics.median(r[2] for r in runs) for runs in (ours, dense))
-    c_ours, c_dense = (statistics.median(r[3] for r in runs) for runs in (ours, dense))
-    print(f"\n## maxmin vs dense at {n_events:.0e} events ({graph.n_nodes} nodes), L = {N_LANDMARKS}, "
-          f"median of {repeats}; same landmarks and distances: yes\n")
+    wall, cpu, peak = ([statistics.median(run[i] for run in runs) for runs in (ours, dense)] for i in (1, 3, 2))
+    print(f"\n## {heading}, L = {N_LANDMARKS}, median of {repeats}; same landmarks and distances: yes\n")
     print("| approach | wall s | CPU s (all threads) | peak MB above baseline |")
     print("|---|---|---|---|")
-    print(f"| dense: all-pairs shortest_path + maxmin | {t_dense:.2f} | {c_dense:.2f} | {m_dense / 2**20:.1f} |")
-    print(f"| ours: bounded searches + L x L | {t_ours:.3f} | {c_ours:.3f} | {m_ours / 2**20:.1f} |")
-    print(f"| ratio (target >= 20x time, >= 50x memory) | {t_dense / t_ours:.0f}x | {c_dense / c_ours:.0f}x | "
-          f"{m_dense / max(m_ours, 1):.0f}x |")
+    print(f"| dense: all-pairs shortest_path + maxmin | {wall[1]:.2f} | {cpu[1]:.2f} | {peak[1] / 2**20:.1f} |")
+    print(f"| ours: bounded searches + L x L | {wall[0]:.3f} | {cpu[0]:.3f} | {peak[0] / 2**20:.1f} |")
+    time_ratio, memory_ratio = wall[1] / wall[0], peak[1] / max(peak[0], 1)
+    print(f"| ratio | {time_ratio:.0f}x | {cpu[1] / cpu[0]:.0f}x | {memory_ratio:.0f}x |")
+    print(f"\ntarget >= 20x faster: {'met' if time_ratio >= 20 else 'NOT met'}; "
+          f">= 50x less memory: {'met' if memory_ratio >= 50 else 'NOT met'}")
+
+
+def against_dense(n_events, repeats=3):
+    graph = build_graph(synthetic_log(n_events, rng=2), "plain")
+    compare_with_dense(graph, f"maxmin vs dense at {n_events:.0e} events ({graph.n_nodes} nodes)", repeats)
 
 
 def main():

@@ -27,16 +27,15 @@ from __future__ import annotations
 
 import argparse
 import os
-import statistics
 
 import numba
 import numpy as np
 
 from _data import simulated_log
 from _measure import machine, revision, run_measured
-from bench_landmarks import dense_maxmin
+from bench_landmarks import compare_with_dense
 from swarmtopo.graph import build_graph
-from swarmtopo.landmarks import SUBSAMPLERS, maxmin
+from swarmtopo.landmarks import SUBSAMPLERS
 from swarmtopo.pipeline import MapConfig, map_encounters
 
 N_LANDMARKS = 500
@@ -87,24 +86,8 @@ def largest_component(graph):
 def against_dense(n_events, repeats=3):
     log = simulated_log(n_events)
     graph = largest_component(build_graph(log, "hybrid"))
-    ours = [run_measured(lambda: maxmin(graph, N_LANDMARKS, rng=0)) for _ in range(repeats)]
-    start = int(ours[0][0].nodes[0])
-    dense = [run_measured(lambda: dense_maxmin(graph, N_LANDMARKS, start)) for _ in range(repeats)]
-    nodes, distances = dense[0][0]
-    np.testing.assert_array_equal(ours[0][0].nodes, nodes)
-    np.testing.assert_allclose(ours[0][0].distances, distances, rtol=1e-12)
-    wall, cpu, peak = ([statistics.median(run[i] for run in runs) for runs in (ours, dense)] for i in (1, 3, 2))
-    print(f"\n## landmark stage vs dense at {log.n_events:,} simulated events (hybrid graph, largest "
-          f"component: {graph.n_nodes:,} nodes), L = {N_LANDMARKS}, median of {repeats}; "
-          "same landmarks and distances: yes\n")
-    print("| approach | wall s | CPU s (all threads) | peak MB above baseline |")
-    print("|---|---|---|---|")
-    print(f"| dense: all-pairs shortest_path + maxmin | {wall[1]:.2f} | {cpu[1]:.2f} | {peak[1] / 2**20:.1f} |")
-    print(f"| ours: bounded searches + L x L | {wall[0]:.3f} | {cpu[0]:.3f} | {peak[0] / 2**20:.1f} |")
-    time_ratio, memory_ratio = wall[1] / wall[0], peak[1] / max(peak[0], 1)
-    print(f"| ratio | {time_ratio:.0f}x | {cpu[1] / cpu[0]:.0f}x | {memory_ratio:.0f}x |")
-    print(f"\ntarget >= 20x faster: {'met' if time_ratio >= 20 else 'NOT met'}; "
-          f">= 50x less memory: {'met' if memory_ratio >= 50 else 'NOT met'}")
+    compare_with_dense(graph, f"landmark stage vs dense at {log.n_events:,} simulated events (hybrid graph, "
+                              f"largest component: {graph.n_nodes:,} nodes)", repeats)
 
 
 def main():

@@ -1,14 +1,13 @@
-"""numba graph kernels: one stoppable Dijkstra search on a CSR graph and its drivers.
+"""numba graph kernels: stoppable Dijkstra searches on a CSR graph and their drivers.
 
 scipy's ``dijkstra`` returns a dense row of length n per source, even when bounded,
 and starts from scratch each time: fine for a few hundred sources, not for the k-NN
-search of every node (10^6 sources).  :func:`settle` is the one hand-written
-search: Dijkstra with a lazy binary heap that stops at a distance limit or after
-enough *counted* nodes are settled, touching only the nodes it reaches (its scratch
-is reset through the list of touched nodes).  It also serves the bounded maxmin
-updates (2x faster than scipy's bounded search, no O(n) row per call) and the
-landmark rows, where scipy took 144 ms per source at 685k nodes against 58 ms here
-with two threads (benchmarks/bench_landmarks.py).
+search of every node (10^6 sources).  Two hand-written searches share one lazy
+binary heap and touch only the nodes they reach (scratch is reset through the list
+of touched nodes): :func:`settle` stops after enough *counted* nodes are settled
+(k-NN rows; landmark-to-landmark rows, where scipy took 133 ms per source at 685k
+nodes against 41 ms here with two threads, benchmarks/bench_landmarks.py), and
+:func:`lower_distances` stops at every node it cannot improve (maxmin picks).
 
 All drivers are deterministic: every source's search is independent, so the parallel
 split over sources changes nothing but the time.
@@ -67,12 +66,11 @@ def _heap_pop(keys, nodes, size):
 
 
 @njit(cache=True)
-def settle(indptr, indices, weights, source, limit, count, stop_count,
+def settle(indptr, indices, weights, source, count, stop_count,
            dist, touched, heap_keys, heap_nodes, found_node, found_dist):
     """Dijkstra from ``source``, settling nodes in order of distance.
 
-    Only nodes at distance ``< limit`` are settled.  Every settled node ``u`` with
-    ``count[u] > 0`` is appended to ``found_node`` / ``found_dist`` (so in
+    Every settled node ``u`` with ``count[u] > 0`` is appended to ``found_node`` / ``found_dist`` (so in
     non-decreasing distance order); the search stops as soon as the counts of the
     found nodes sum to ``>= stop_count``.
 
@@ -107,7 +105,7 @@ def settle(indptr, indices, weights, source, limit, count, stop_count,
         for e in range(indptr[u], indptr[u + 1]):
             v = indices[e]
             nd = d + weights[e]
-            if nd < dist[v] and nd < limit:
+            if nd < dist[v]:
                 if dist[v] == np.inf:
                     touched[n_touched] = v
                     n_touched += 1
@@ -157,7 +155,7 @@ def lower_distances(indptr, indices, weights, source, to_set, dist, touched, hea
 
 
 class Searcher:
-    """Scratch arrays for repeated :func:`settle` calls on one graph (single thread)."""
+    """Scratch arrays for repeated :func:`lower_distances` calls on one graph (single thread)."""
 
     def __init__(self, indptr, indices, weights):
         n = len(indptr) - 1
@@ -166,16 +164,6 @@ class Searcher:
         self.touched = np.empty(n, np.int64)
         self.heap_keys = np.empty(len(weights) + 1)
         self.heap_nodes = np.empty(len(weights) + 1, np.int64)
-        self.found_node = np.empty(n, np.int64)
-        self.found_dist = np.empty(n)
-        self.count_all = np.ones(n, np.int64)
-
-    def ball(self, source: int, limit: float) -> tuple[np.ndarray, np.ndarray]:
-        """Nodes at distance < ``limit`` from ``source`` and their distances (views)."""
-        n_found = settle(self.indptr, self.indices, self.weights, source, limit,
-                         self.count_all, np.iinfo(np.int64).max, self.dist, self.touched,
-                         self.heap_keys, self.heap_nodes, self.found_node, self.found_dist)
-        return self.found_node[:n_found], self.found_dist[:n_found]
 
     def add_landmark(self, source: int, to_set: np.ndarray) -> int:
         """Lower ``to_set`` (d(x, L), all nodes) for L + {source}; see :func:`lower_distances`."""
@@ -197,7 +185,7 @@ def _knn_rows(indptr, indices, weights, multiplicity, k, n_blocks):
         for x in range(block, n, n_blocks):
             # stop once x's own points plus k others are settled: each node counts its
             # multiplicity, so at most k + 1 nodes are found
-            n_found = settle(indptr, indices, weights, x, np.inf, multiplicity, k + 1,
+            n_found = settle(indptr, indices, weights, x, multiplicity, k + 1,
                              dist, touched, heap_keys, heap_nodes, found_node, found_dist)
             filled = 0
             for j in range(n_found):
@@ -233,7 +221,7 @@ def _rows_to_targets(indptr, indices, weights, sources, targets, n_blocks):
         found_node = np.empty(n_targets, np.int64)
         found_dist = np.empty(n_targets)
         for i in range(block, len(sources), n_blocks):
-            n_found = settle(indptr, indices, weights, sources[i], np.inf, is_target, n_targets,
+            n_found = settle(indptr, indices, weights, sources[i], is_target, n_targets,
                              dist, touched, heap_keys, heap_nodes, found_node, found_dist)
             for j in range(n_found):
                 out[i, column[found_node[j]]] = found_dist[j]
