@@ -54,7 +54,8 @@ def test_map_writes_map_json_and_figures(tmp_path, simulated):
     proc = run("map", simulated[0], "--out", tmp_path / "m", "--landmarks", 200)
     assert proc.returncode == 0, proc.stderr
     doc = json.loads((tmp_path / "m" / "map.json").read_text())
-    assert set(doc) >= {"betti", "diagrams", "params", "timings", "thresholds", "software"}
+    assert set(doc) >= {"betti", "confidence", "diagrams", "params", "timings", "classifier", "software"}
+    assert doc["classifier"]["classifier"] == "default"
     assert doc["betti"]["0"] == 1
     assert doc["params"]["landmarks"] == 200
     assert f"beta_1 = {doc['betti']['1']}" in proc.stdout
@@ -82,7 +83,11 @@ def test_map_never_reads_ground_truth(tmp_path, simulated):
 def test_demo_prints_recovered_and_true_betti_numbers(tmp_path):
     proc = run("demo", "--out", tmp_path / "demo")
     assert proc.returncode == 0, proc.stderr
-    assert "recovered: beta_0 = 1, beta_1 =" in proc.stdout
+    doc = json.loads((tmp_path / "demo" / "map.json").read_text())
+    # the verdict is map.json's, with each Betti number's confidence in percent
+    b1, c0, c1 = doc["betti"]["1"], doc["confidence"]["0"], doc["confidence"]["1"]
+    assert f"recovered: beta_0 = 1 ({100 * c0:.0f}% confidence), beta_1 = {b1} ({100 * c1:.0f}% confidence)" \
+        in proc.stdout
     assert "true:      beta_0 = 1, beta_1 = 1" in proc.stdout
     assert (tmp_path / "demo" / "map.json").exists() and (tmp_path / "demo" / "log" / "events.csv").exists()
 

@@ -293,3 +293,71 @@ def test_backend_choice():
     for name in set(BACKENDS) - set(INSTALLED):
         with pytest.raises(SwarmtopoError, match="not installed"):
             rips_persistence(SQUARE, backend=name)
+
+
+def test_rounding_noise_bars_are_dropped_relative_to_the_diagram_scale():
+    # a 1e-15 s bar among bars of seconds is two orders of summing one path: dropped
+    dgm = Diagram(pairs=(np.array([[0.0, np.inf]]), np.array([[4.0, 4.0 + 8.9e-16], [3.0, 9.0]])), backend="t")
+    assert dgm.lengths(1).tolist() == [6.0]
+    # the same shapes at a tiny scale are real bars: the floor is relative
+    tiny = Diagram(pairs=(np.array([[0.0, np.inf]]), np.array([[4e-12, 5e-12], [3e-12, 9e-12]])), backend="t")
+    assert len(tiny.lengths(1)) == 2
+
+
+def test_simulated_maps_have_no_rounding_noise_bars():
+    from swarmtopo.arena import random_arena
+    from swarmtopo.pipeline import MapConfig, map_encounters
+    from swarmtopo.sim import simulate
+
+    sim = simulate(random_arena(2, rng=0), 200, 30.0, rng=0)
+    tmap = map_encounters(sim.log, MapConfig(metric="contracted", landmarks=300, embed_dim=0))
+    # every bar is at least one time step (0.1 s) long: distances are sums of time gaps
+    assert tmap.diagram.lengths(1).min() >= 0.1 - 1e-9
+
+
+# -- SNR (paper, "Probabilistic maxmin") ----------------------------------------------
+def snr_diagram():
+    # H0: one infinite bar and [0, 2]; H1 lengths 4, 1, 0.5
+    return Diagram(pairs=(np.array([[0.0, np.inf], [0.0, 2.0]]),
+                          np.array([[1.0, 5.0], [1.0, 2.0], [1.0, 1.5]])), backend="t")
+
+
+def test_snr_hand_computed():
+    from swarmtopo.persistence import snr
+
+    s = snr(snr_diagram(), 1, 1)
+    # signal: the longest bar (4) -> P_S = 16; noise: 1 and 0.5 -> P_N = (1 + 0.25) / 2
+    assert (s.signal_power, s.noise_power, s.ratio) == pytest.approx((16.0, 0.625, 25.6))
+    # beta = 2: P_S = (16 + 1) / 2, P_N = 0.25
+    assert snr(snr_diagram(), 1, 2).ratio == pytest.approx(8.5 / 0.25)
+
+
+def test_snr_without_signal_is_the_noise_power_alone():
+    from swarmtopo.persistence import snr
+
+    s = snr(snr_diagram(), 1, 0)
+    assert s.signal_power == 0 and s.ratio == 0
+    assert s.noise_power == pytest.approx((16 + 1 + 0.25) / 3)
+
+
+def test_snr_caps_infinite_bars_and_handles_missing_noise():
+    from swarmtopo.persistence import snr
+
+    # the infinite H0 bar counts as long as the largest finite death (5) minus its birth
+    s = snr(snr_diagram(), 0, 1)
+    assert (s.signal_power, s.noise_power) == pytest.approx((25.0, 4.0))
+    assert snr(snr_diagram(), 0, 1, infinite_length=10.0).signal_power == pytest.approx(100.0)
+    # every bar is signal: no noise, infinite ratio; more signal asked than bars: zeros
+    assert snr(snr_diagram(), 1, 3).ratio == np.inf
+    assert snr(snr_diagram(), 1, 4).signal_power == pytest.approx((16 + 1 + 0.25) / 4)
+
+
+def test_mean_snr_averages_the_ratios_of_independent_runs():
+    from swarmtopo.persistence import mean_snr, snr
+
+    other = Diagram(pairs=(np.array([[0.0, np.inf]]), np.array([[0.0, 2.0], [0.0, 1.0]])), backend="t")
+    assert mean_snr([snr_diagram(), other], 1, 1) == pytest.approx((25.6 + 4.0) / 2)
+    with pytest.raises(InputError):
+        mean_snr([], 1, 1)
+    with pytest.raises(InputError):
+        snr(other, 1, -1)

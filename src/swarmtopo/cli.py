@@ -114,17 +114,22 @@ def map_command(
                                          help="Time window T0:T1 in seconds (either end may be empty)."),
     maxdim: int = typer.Option(1, "--maxdim", min=1, max=2, help="Highest homology dimension (1 or 2)."),
     seed: int = typer.Option(0, "--seed", help="Seed of landmark start and MDS."),
+    classifier: str = typer.Option(
+        "default", "--classifier",
+        help="Betti classifier: default (trained by the project), paper (the paper's Theta*), or a JSON file."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
 ) -> None:
-    """Map an encounter log folder: Betti numbers, diagrams and pictures."""
+    """Map an encounter log folder: Betti numbers with confidence, diagrams and pictures."""
+    from .classify import load_classifier
     from .io import read_log
     from .pipeline import MapConfig
 
     out_dir = out_dir or log_dir / "map"
+    model = load_classifier(classifier)
     log = read_log(log_dir)
     config = MapConfig(metric=metric, subsample=subsample, landmarks=landmarks,
                        window=window, maxdim=maxdim, seed=seed)
-    tmap, written = _run_map(log, config, log_dir, out_dir, quiet)
+    tmap, written = _run_map(log, config, log_dir, out_dir, quiet, classifier=model)
     if not quiet:
         _print_verdict(tmap, truth=None)
         out.print(f"wrote {', '.join(str(p) for p in written)}")
@@ -158,14 +163,106 @@ def demo(
         out.print(f"wrote {', '.join(str(p) for p in written)}")
 
 
-def _run_map(log, config, log_dir: Path, out_dir: Path, quiet: bool):
+@app.command(epilog="Example: swarmtopo sweep examples/sweep-small.toml --store results.duckdb --workers 2  "
+                    "(run it again after a crash or Ctrl-C: finished jobs are skipped)")
+def sweep(
+    config: Path = typer.Argument(..., help="Sweep grid: a TOML file with sweep, arena, swarm and map tables."),
+    store: Path = typer.Option(..., "--store", help="DuckDB result store (created; one row per job in table jobs)."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler",
+                                            help="Address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786."),
+    workers: Optional[int] = typer.Option(None, "--workers", min=1,
+                                          help="Worker processes of the local cluster (default: all cores)."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
+) -> None:
+    """Run every simulate-and-map job of a grid on Dask and store one row per job.
+
+    Jobs already in the store are skipped, so a sweep can be resumed or grown.
+    """
+    from .experiments.grid import read_sweep
+    from .experiments.sweep import run_sweep
+
+    grid = read_sweep(config)
+    try:
+        with _sweep_progress(quiet) as tick:
+            summary = run_sweep(grid.jobs, store, scheduler=scheduler, workers=workers, progress=tick)
+    except KeyboardInterrupt:
+        if not quiet:
+            err.print(f"interrupted: finished jobs are saved in {store}; run the same command again to run the rest",
+                      markup=False, highlight=False, soft_wrap=True)
+        raise typer.Exit(130) from None
+    if quiet:
+        return
+    if summary.run == 0:
+        out.print(f"sweep {grid.name!r}: all {summary.total} jobs already in {store}; nothing to run",
+                  markup=False, highlight=False)
+        return
+    out.print(f"sweep {grid.name!r}: {summary.total} jobs: {summary.run} run ({summary.failed} failed), "
+              f"{summary.skipped} already in the store", markup=False, highlight=False)
+    out.print(f"{summary.run} jobs in {summary.seconds:.1f} s on {summary.workers} worker(s): "
+              f"{summary.jobs_per_minute:.1f} jobs/minute", markup=False, highlight=False)
+    for message, count in sorted(summary.errors.items(), key=lambda item: -item[1])[:3]:
+        out.print(f"failed {count}x: {message}", markup=False, highlight=False, soft_wrap=True)
+    out.print(f"results: {store} (table jobs)", markup=False, highlight=False)
+
+
+@app.command(epilog="Example: swarmtopo reproduce encmds --out reproduction/encmds --runs 5  "
+                    "(clust runs its sweeps on Dask: --workers N or --scheduler ADDRESS)")
+def reproduce(
+    name: str = typer.Argument(..., help="Experiment: enc | encmds | encimpr | land2 | clust."),
+    out_dir: Optional[Path] = typer.Option(None, "--out", help="Output folder (default: reproduction/NAME)."),
+    runs: Optional[int] = typer.Option(None, "--runs", min=1,
+                                       help="Environments or repetitions, scaled down for a quick look "
+                                            "(default: the documented full size)."),
+    workers: Optional[int] = typer.Option(None, "--workers", min=1, help="clust: local Dask worker processes."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="clust: address of an existing Dask scheduler."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
+) -> None:
+    """Reproduce one of the paper's experiments: PNG figures, NAME.csv (one row per run),
+    NAME.md (summary table) and NAME.json (summary and settings) in the output folder."""
+    from .experiments.reproduce import REPRODUCTIONS, reproduce as run
+
+    if name not in REPRODUCTIONS:
+        raise typer.BadParameter(f"{name!r} is not one of {', '.join(REPRODUCTIONS)}", param_hint="NAME")
+    if name != "clust" and (workers is not None or scheduler is not None):
+        raise typer.BadParameter("--workers and --scheduler apply to clust only (the others run in this process)")
+    out_dir = out_dir or Path("reproduction") / name
+    options = {"workers": workers, "scheduler": scheduler} if name == "clust" else {}
+    with _sweep_progress(quiet, label=name) as tick:
+        result = run(name, out_dir, runs=runs, progress=tick, **options)
+    if not quiet:
+        out.print(result.table_markdown, markup=False, highlight=False)
+        written = [*result.figures, result.table, out_dir / f"{name}.md", out_dir / f"{name}.json"]
+        out.print(f"wrote {', '.join(str(p) for p in written)}", markup=False, highlight=False)
+
+
+@contextmanager
+def _sweep_progress(quiet: bool, label: str = "sweep"):
+    """progress(done, total, failed): a Rich bar on a terminal, a line per job in pipes."""
+    if quiet:
+        yield lambda done, total, failed: None
+        return
+    if not err.is_terminal:
+        def line(done, total, failed):
+            if done:
+                err.print(f"{done}/{total} jobs done ({failed} failed)", markup=False, highlight=False)
+        yield line
+        return
+    with Progress(TextColumn(label), BarColumn(), TextColumn("{task.completed}/{task.total} jobs"),
+                  TextColumn("{task.fields[failed]} failed"), TimeElapsedColumn(), TimeRemainingColumn(),
+                  console=err, transient=True) as bar:
+        task = bar.add_task(label, total=None, failed=0)
+        yield lambda done, total, failed: bar.update(task, completed=done, total=total, failed=failed)
+
+
+def _run_map(log, config, log_dir: Path, out_dir: Path, quiet: bool, classifier=None):
     """Map, write map.json and figures; ground truth beside the log only colours pictures,
     and a broken ground-truth file costs a warning, never the map."""
     from .pipeline import STAGES, map_encounters
     from .report import write_map_outputs
 
     with _progress("mapping", quiet) as tick:
-        tmap = map_encounters(log, config, progress=lambda stage: tick(STAGES.index(stage) / len(STAGES)))
+        tmap = map_encounters(log, config, classifier=classifier,
+                              progress=lambda stage: tick(STAGES.index(stage) / len(STAGES)))
         tick(1.0)
     arena, truth = _ground_truth(log, log_dir, quiet)
     return tmap, write_map_outputs(tmap, out_dir, log=log, truth=truth, arena=arena)
@@ -203,7 +300,11 @@ def _warn(message: str, quiet: bool) -> None:
 
 
 def _print_verdict(tmap, truth) -> None:
-    est = ", ".join(f"beta_{n} = {b}" for n, b in sorted(tmap.betti.items()))
+    def confidence(n):
+        p = tmap.confidence.get(n)
+        return "" if p is None else f" ({100 * p:.0f}% confidence)"
+
+    est = ", ".join(f"beta_{n} = {b}{confidence(n)}" for n, b in sorted(tmap.betti.items()))
     out.print(f"recovered: {est}")
     if truth is not None:
         out.print(f"true:      beta_0 = {truth[0]}, beta_1 = {truth[1]}")

@@ -27,7 +27,7 @@ from typing import Any, Callable
 import numpy as np
 
 from . import __version__
-from .classify import BettiRule, RegionScales, default_rule
+from .classify import BettiClassifier, RegionScales, load_classifier
 from .embed import Embedding, mds
 from .errors import SwarmtopoError
 from .graph import METRICS, EncounterGraph, build_graph
@@ -40,9 +40,12 @@ from .persistence import Diagram, rips_persistence
 MIN_REGION_AGENTS = 3
 """Distinct agents a component needs to count as a region (two agents alone that keep
 meeting say nothing about the arena)."""
-AUTO_LANDMARKS_MAX = 1000
-"""Most landmarks the automatic count takes per region (persistence stays ~1 s)."""
-STAGES = ("graph", "landmarks", "persistence", "embedding")
+AUTO_COVER_FACTOR = 1.5
+"""The automatic landmark count stops once r_cover <= AUTO_COVER_FACTOR * s (s: the
+region's k-NN scale).  The landmarks' diagram is within bottleneck 2 r_cover of the
+whole cloud's, so subsampling moves no bar by more than 3 s: the order of the
+cloud's own Rips noise bars."""
+STAGES = ("graph", "landmarks", "persistence", "embedding", "classify")
 """Stage names passed to ``map_encounters``'s progress callback, in order."""
 
 
@@ -62,9 +65,12 @@ class MapConfig:
     landmarks
         Number of landmarks L for the whole map, shared between regions in
         proportion to their events.  None (default): per region, the fewest
-        landmarks whose covering radius meets the Betti rule's sampling guarantee
-        (``rule.max_cover_radius``), at most ``AUTO_LANDMARKS_MAX``; maxmin-type
-        selection is greedy, so these are the first landmarks of a longer run.
+        landmarks whose covering radius is at most ``AUTO_COVER_FACTOR`` times the
+        region's k-NN scale, at most ``max_landmarks``; maxmin-type selection is
+        greedy, so these are the first landmarks of a longer run.
+    max_landmarks
+        Cap of the automatic landmark count per region (default 1000: persistence
+        stays around a second).
     window
         Optional time window (t0, t1) on the events, seconds; None = whole log.
     maxdim
@@ -84,6 +90,7 @@ class MapConfig:
     metric: str = "hybrid"
     subsample: str = "maxmin"
     landmarks: int | None = None
+    max_landmarks: int = 1000
     window: tuple[float | None, float | None] | None = None
     maxdim: int = 1
     seed: int | None = 0
@@ -101,6 +108,8 @@ class MapConfig:
                 f"unknown subsampler {self.subsample!r}; expected one of {', '.join(SUBSAMPLERS)}")
         if self.landmarks is not None and self.landmarks < 3:
             raise SwarmtopoError(f"landmarks must be at least 3, got {self.landmarks}")
+        if self.max_landmarks < 3:
+            raise SwarmtopoError(f"max_landmarks must be at least 3, got {self.max_landmarks}")
         if self.maxdim not in (1, 2):
             raise SwarmtopoError(f"maxdim must be 1 or 2, got {self.maxdim}")
         if self.embed_dim not in (0, 2, 3):
@@ -128,6 +137,7 @@ class RegionMap:
     scales: RegionScales
     thresholds: dict[int, float]  # bar-length threshold per dimension n >= 1
     betti: dict[int, int]
+    confidence: dict[int, float | None]  # P(betti[n] is right), n >= 1
     warnings: list[str]
     embedding: Embedding | None
 
@@ -137,14 +147,19 @@ class TopologicalMap:
     """The result of mapping an encounter log.
 
     ``betti[n]`` is the estimated n-th Betti number: beta_0 counts regions, beta_1
-    holes.  ``diagram`` is the union of the regions' diagrams.
+    holes (None for a dimension the classifier has no Theta_n for).
+    ``confidence[n]`` is the probability that ``betti[n]`` is right (see
+    :mod:`swarmtopo.classify`; beta_n for n >= 1 is a sum over regions, so its
+    confidence is the product of the regions'; None without a calibrated classifier).
+    ``diagram`` is the union of the regions' diagrams.
     """
 
-    betti: dict[int, int]
+    betti: dict[int, int | None]
+    confidence: dict[int, float | None]
     diagram: Diagram
     regions: list[RegionMap]
     too_little_data: list[dict[str, int]]
-    rule: dict[str, Any]
+    classifier: dict[str, Any]
     config: MapConfig
     timings: dict[str, float]
     n_events: int
@@ -159,11 +174,10 @@ class TopologicalMap:
     def to_json(self) -> dict[str, Any]:
         """The map.json document (deaths of infinite bars as null)."""
         return {
-            "betti": {str(k): int(v) for k, v in sorted(self.betti.items())},
+            "betti": {str(k): v for k, v in sorted(self.betti.items())},
+            "confidence": {str(k): v for k, v in sorted(self.confidence.items())},
             "diagrams": self.diagram.to_json(),
-            "thresholds": {**self.rule, "regions": [
-                {"component": r.component, "length": {str(n): float(v) for n, v in r.thresholds.items()}}
-                for r in self.regions]},
+            "classifier": self.classifier,
             "warnings": self.warnings,
             "regions": [
                 {
@@ -175,6 +189,7 @@ class TopologicalMap:
                     "knn_scale": float(r.scales.knn),
                     "thresholds": {str(n): float(v) for n, v in r.thresholds.items()},
                     "betti": {str(k): int(v) for k, v in sorted(r.betti.items())},
+                    "confidence": {str(k): v for k, v in sorted(r.confidence.items())},
                     "diagrams": r.diagram.to_json(),
                     "mds_stress": None if r.embedding is None else float(r.embedding.stress),
                     "warnings": r.warnings,
@@ -193,7 +208,7 @@ def map_encounters(
     log: EncounterLog,
     config: MapConfig | None = None,
     *,
-    rule: BettiRule | None = None,
+    classifier: BettiClassifier | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> TopologicalMap:
     """Map an encounter log to Betti numbers, diagrams and pictures.
@@ -204,9 +219,9 @@ def map_encounters(
         The encounter log (simulated or real).
     config
         Pipeline options; defaults to ``MapConfig()``.
-    rule
-        How Betti numbers are read off the diagrams; defaults to
-        :func:`swarmtopo.classify.default_rule`.
+    classifier
+        How Betti numbers n >= 1 are read off each region's diagram; defaults to
+        the shipped ``load_classifier("default")``.
     progress
         Optional callable receiving the name of each stage (``STAGES``) as it starts.
 
@@ -217,7 +232,7 @@ def map_encounters(
         to count as a region.
     """
     config = (config or MapConfig()).validate()
-    rule = rule or default_rule()
+    classifier = classifier or load_classifier("default")
     rng = np.random.default_rng(config.seed)
     say = progress or (lambda stage: None)
     timings = dict.fromkeys(STAGES, 0.0)
@@ -249,10 +264,10 @@ def map_encounters(
         sub = graph.subgraph(np.flatnonzero(labels == comp))
         say("landmarks")
         t0 = time.perf_counter()
-        knn_scale = _knn_scale(sub, rule.knn_k)
+        knn_scale = _knn_scale(sub, config.knn_k)
         if n_land is None:
-            land = _subsample(sub, config, min(AUTO_LANDMARKS_MAX, sub.n_nodes), rng)
-            land = _first_covering(land, rule.max_cover_radius(knn_scale))
+            land = _subsample(sub, config, min(config.max_landmarks, sub.n_nodes), rng)
+            land = _first_covering(land, AUTO_COVER_FACTOR * knn_scale)
         else:
             land = _subsample(sub, config, int(min(n_land, sub.n_nodes)), rng)
         scales = RegionScales(knn=knn_scale, cover_radius=float(land.cover_radius))
@@ -266,6 +281,12 @@ def map_encounters(
         emb = (mds(land.distances, dim=config.embed_dim, rng=rng)
                if config.embed_dim and len(land.nodes) > config.embed_dim else None)
         timings["embedding"] += time.perf_counter() - t0
+        say("classify")
+        t0 = time.perf_counter()
+        betti_region = classifier.betti(dgm)
+        confidence_region = classifier.confidence(dgm)
+        thresholds = classifier.thresholds(dgm)
+        timings["classify"] += time.perf_counter() - t0
         regions.append(RegionMap(
             component=comp,
             n_events=int(events_per_comp[comp]),
@@ -274,25 +295,31 @@ def map_encounters(
             landmark_events=sub.representative_event()[land.nodes],
             diagram=dgm,
             scales=scales,
-            thresholds=rule.thresholds(dgm, scales),
-            betti=rule.betti(dgm, scales),
-            warnings=rule.warnings(scales),
+            thresholds=thresholds,
+            betti=betti_region,
+            confidence=confidence_region,
+            warnings=_sampling_warnings(scales, len(land.nodes), config),
             embedding=emb,
         ))
 
-    betti = {0: len(regions)}
+    betti: dict[int, int | None] = {0: len(regions)}
+    confidence: dict[int, float | None] = {0: classifier.beta0_confidence()}
     for n in range(1, config.maxdim + 1):
-        betti[n] = sum(r.betti.get(n, 0) for r in regions)
+        known = all(n in r.betti for r in regions)
+        betti[n] = sum(r.betti[n] for r in regions) if known else None
+        region_conf = [r.confidence.get(n) for r in regions]
+        confidence[n] = (float(np.prod(region_conf)) if known and None not in region_conf else None)
     too_little = [{"component": int(c), "events": int(events_per_comp[c]), "agents": int(agents_per_comp[c])}
                   for c in range(n_comp) if not is_region[c]]
     return TopologicalMap(
         betti=betti,
+        confidence=confidence,
         diagram=Diagram(pairs=tuple(np.vstack([r.diagram[n] for r in regions])
                                     for n in range(config.maxdim + 1)),
                         backend=regions[0].diagram.backend),
         regions=regions,
         too_little_data=too_little,
-        rule=rule.describe(),
+        classifier=classifier.describe(),
         config=config,
         timings=timings,
         n_events=graph.n_events,
@@ -332,6 +359,16 @@ def _knn_scale(graph: EncounterGraph, k: int) -> float:
     k = min(k, graph.n_nodes - 1)
     distinct = replace(graph, multiplicity=np.ones_like(graph.multiplicity))
     return float(np.median(knn_distances(distinct, k).mean(axis=1)))
+
+
+def _sampling_warnings(scales: RegionScales, n_landmarks: int, config: MapConfig) -> list[str]:
+    """Why a region's answer may be unreliable (empty when it is not)."""
+    if scales.cover_radius > AUTO_COVER_FACTOR * scales.knn:
+        return [f"landmarks too sparse: {n_landmarks} landmarks leave a covering radius of "
+                f"{scales.cover_radius:.3g} s, over {AUTO_COVER_FACTOR:g} x the cloud's k-NN scale "
+                f"{scales.knn:.3g} s, so subsampling noise can pass the threshold; use more landmarks"
+                + ("" if config.landmarks else f" (raise max_landmarks above {config.max_landmarks})")]
+    return []
 
 
 def _subsample(graph: EncounterGraph, config: MapConfig, n_landmarks: int, rng) -> Landmarks:

@@ -131,3 +131,111 @@ def new_figure(width: float, height: float):
     return Figure(figsize=(width, height), layout="constrained")
 
 
+# -- figures of the paper's experiments (swarmtopo.experiments.reproduce) -------------------
+def cyclic_colors(angle: np.ndarray, cmap: str = "twilight") -> np.ndarray:
+    """RGB colours of angles (radians) on a cyclic colour map: -pi and pi get one colour."""
+    from matplotlib import colormaps
+
+    fraction = np.mod(np.asarray(angle, dtype=float), 2 * np.pi) / (2 * np.pi)
+    return colormaps[cmap](fraction)[:, :3]
+
+
+def plot_bar_separation(longest, second, ax=None, *, groups=None, title=None):
+    """Longest against second-longest H1 bar, one point per run.
+
+    A run with one clear hole sits far above the diagonal (drawn, with the line
+    longest = 2 x second dashed); noise alone sits near it.  ``groups`` (one label per
+    run) colours the runs by condition, with a legend.
+    """
+    ax = _axes(ax)
+    longest, second = np.asarray(longest, dtype=float), np.asarray(second, dtype=float)
+    labels = np.asarray(groups if groups is not None else [""] * len(longest), dtype=object)
+    for i, label in enumerate(dict.fromkeys(labels.tolist())):
+        pick = labels == label
+        ax.scatter(second[pick], longest[pick], s=22, alpha=0.8, color=f"C{i}", label=label or None)
+    finite = np.concatenate([longest[np.isfinite(longest)], second[np.isfinite(second)], [1.0]])
+    top = float(finite.max()) * 1.1
+    ax.plot([0, top], [0, top], color="0.5", lw=1, label="longest = second")
+    ax.plot([0, top / 2], [0, top], color="0.5", lw=1, ls="--", label="longest = 2 x second")
+    ax.set_xlim(0, top)
+    ax.set_ylim(0, top)
+    ax.set_xlabel("second-longest H1 bar (s)")
+    ax.set_ylabel("longest H1 bar (s)")
+    ax.legend(loc="lower right", fontsize=8)
+    ax.set_title(title or "H1 bar separation per run")
+    return ax
+
+
+def plot_distributions(samples, ax=None, *, ylabel: str = "", log_scale: bool = False, title=None):
+    """Box plot of one sample per label (``samples``: mapping label -> values; box:
+    quartiles, whiskers: minimum to maximum), with the values themselves overlaid
+    (evenly spread sideways in order, no randomness) and each mean marked by a diamond.
+    Infinite values are left out."""
+    ax = _axes(ax)
+    labels = list(samples)
+    values = [np.asarray(samples[k], dtype=float) for k in labels]
+    values = [v[np.isfinite(v)] for v in values]
+    ax.boxplot(values, tick_labels=labels, whis=(0, 100), showfliers=False, widths=0.5)
+    for i, v in enumerate(values, start=1):
+        offsets = np.linspace(-0.18, 0.18, len(v)) if len(v) > 1 else np.zeros(len(v))
+        ax.scatter(i + offsets[np.argsort(np.argsort(v))], v, s=8, alpha=0.45, color=f"C{i - 1}")
+        if len(v):
+            ax.scatter([i], [v.mean()], marker="D", s=40, color="k", zorder=3,
+                       label="mean" if i == 1 else None)
+    if log_scale:
+        ax.set_yscale("log")
+    ax.set_ylabel(ylabel)
+    if any(len(v) for v in values):
+        ax.legend(loc="upper left", fontsize=8)
+    ax.set_title(title or "")
+    return ax
+
+
+def plot_ratio_density(diagrams, truth, theta, ax=None, *, dim: int = 1, title=None):
+    """Density of the scaled lengths l / (l_q + Delta) of dgm_dim over many maps, the
+    true beta longest bars of each map ("holes") apart from the rest, with tau drawn
+    (the paper's Fig. "clust" (c))."""
+    from .classify import bar_lengths, quantile_scale
+
+    ax = _axes(ax)
+    holes, rest = [], []
+    for dgm, beta in zip(diagrams, truth):
+        lengths = bar_lengths(dgm, dim)
+        lengths = lengths[np.isfinite(lengths)]
+        scale = quantile_scale(lengths, theta.q, theta.delta)
+        if scale <= 0 or not len(lengths):
+            continue
+        ratios = lengths / scale  # decreasing, like the lengths
+        holes.append(ratios[:beta])
+        rest.append(ratios[beta:])
+    holes, rest = np.concatenate(holes or [[]]), np.concatenate(rest or [[]])
+    both = np.concatenate([holes, rest])
+    both = both[both > 0]
+    if len(both):
+        bins = np.geomspace(both.min(), both.max(), 60)
+        ax.hist(rest[rest > 0], bins=bins, density=True, alpha=0.6, color="tab:gray", label="other bars")
+        ax.hist(holes[holes > 0], bins=bins, density=True, alpha=0.6, color="tab:red",
+                label="the beta longest bars")
+    ax.axvline(theta.tau, color="k", ls="--", lw=1, label=f"tau = {theta.tau:.2g}")
+    ax.set_xscale("log")
+    ax.set_xlabel(f"l / (l_q + Delta),  q = {theta.q:.2g}, Delta = {theta.delta:.2g} s")
+    ax.set_ylabel("density")
+    ax.legend(fontsize=7)
+    if title:
+        ax.set_title(title, fontsize=9)
+    return ax
+
+
+def plot_scores_by(values, series: dict, ax=None, *, xlabel: str, ylabel: str, title=None):
+    """One line per entry of ``series`` (name -> score per value of ``values``)."""
+    ax = _axes(ax)
+    for name, scores in series.items():
+        ax.plot(values, scores, marker="o", label=name)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_xticks(list(values))
+    ax.legend(fontsize=7)
+    if title:
+        ax.set_title(title, fontsize=9)
+    return ax

@@ -1,0 +1,1 @@
+"""Data shipped with swarmtopo: the fitted classifiers (classifier-*.json)."""

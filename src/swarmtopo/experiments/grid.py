@@ -1,0 +1,457 @@
+"""Sweep grids: a TOML file -> the simulate-and-map jobs it stands for.
+
+Format (``examples/sweep-small.toml`` is a commented example)::
+
+    [sweep]
+    name = "two-holes"        # label of the sweep (default: the file name without .toml)
+    replicates = 5            # jobs (seeds) per grid point (default 1)
+    salt = "train"            # text mixed into every job's seed and key (default "")
+
+    [arena]
+    generator = "random"      # random | default | square | annulus | two_rooms | file
+    holes = [1, 2, 3]         # random, two_rooms: number of holes (default 1)
+    shapes = "square"         # random, two_rooms: hole families (default "square")
+    outer = "square"          # random: outer wall square | rectangle | polygon
+    scale = [0.75, 1.0]       # all: scale factor of every length (default 1.0)
+    r_outer = 250.0           # annulus: outer radius, mm (default 250)
+    r_inner = 150.0           # annulus: inner radius, mm (default 150)
+    path = "arena.geojson"    # file: GeoJSON arena, relative to the TOML file
+
+    [swarm]
+    agents = 200              # swarm size N (default 200)
+    duration = 20.0           # seconds of data (default 20)
+    static_fraction = 0.0     # fraction of agents stopped for good (default 0)
+    static_time = 0.0         # when they stop, s (default 0; only with static_fraction > 0)
+
+    [map]
+    metric = "hybrid"         # plain | contracted | hybrid (default hybrid)
+    subsample = "maxmin"      # maxmin | knn | probabilistic (default maxmin)
+    landmarks = "auto"        # an integer L >= 3, or "auto" (default)
+    max_landmarks = 1000      # cap of the automatic count (only with landmarks = "auto")
+    maxdim = 1                # highest homology dimension, 1 or 2 (default 1)
+    classifier = "default"    # "default", "paper", or a classifier JSON file
+
+Every value of ``[arena]``, ``[swarm]`` and ``[map]`` may be a scalar or a list; lists
+expand into the Cartesian product of all lists, times ``replicates``.  ``shapes`` is a
+set of hole families, each hole drawing its family uniformly from the set: a string
+or a list of strings is one set (``["square", "disc"]``: every arena mixes squares and
+discs); a list of lists is a grid over sets (``[["square"], ["square", "disc"]]``: two
+grid points).  A set is canonical sorted, so ``["disc", "square"]`` is the same job.
+
+Canonical configuration.  Each grid point becomes a nested dict ``{"arena": ...,
+"swarm": ..., "map": ...}`` with defaults filled in and only the keys its generator
+and options use (``holes`` is dropped for ``generator = "default"``, ``static_time``
+when ``static_fraction = 0``, ``max_landmarks`` when ``landmarks`` is a number);
+points that become equal are one job.  A key given in the file that no grid point
+uses is an error.  Input files (``path``, a classifier path) enter the configuration
+as written plus the SHA-256 of their bytes, so a job is tied to the file's content;
+workers read them at their absolute path (on a cluster of several machines, keep them
+on a shared file system).
+
+Job identity.  ``job.key`` is the SHA-256 (hex) of the canonical JSON of (config,
+replicate, salt); ``job.seed`` is the first 64 bits of the same hash.  Neither depends
+on the job's position in the grid, so growing a grid never changes finished jobs.
+The job's randomness comes from ``np.random.SeedSequence(job.seed)``, spawned into
+independent streams (arena, simulation, map): see :meth:`Job.stream_seeds`.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from ..arena import HOLE_SHAPES, OUTER_SHAPES
+from ..classify import PRESETS, load_classifier
+from ..errors import InputError, SwarmtopoError
+from ..graph import METRICS
+from ..io import read_arena
+from ..landmarks import SUBSAMPLERS
+from ..pipeline import MapConfig
+
+GENERATORS: dict[str, tuple[str, ...]] = {
+    "random": ("holes", "shapes", "outer", "scale"),
+    "default": ("scale",),
+    "square": ("scale",),
+    "annulus": ("r_outer", "r_inner", "scale"),
+    "two_rooms": ("holes", "shapes", "scale"),
+    "file": ("path", "scale"),
+}
+"""Arena generators and the ``[arena]`` keys each one uses (besides ``generator``)."""
+STREAMS = ("arena", "simulation", "map")
+"""The independent random streams of a job, in :meth:`Job.stream_seeds` order."""
+
+
+class _Bad(Exception):
+    """A value outside its key's domain (message: what was expected)."""
+
+
+# -- value checks: each returns the canonical value or raises _Bad --------------------------
+def _integer(lo: int, hi: int | None = None) -> Callable[[Any], int]:
+    def check(value):
+        if isinstance(value, bool) or not isinstance(value, int) or value < lo or (hi is not None and value > hi):
+            raise _Bad(f"expected an integer {'>= ' + str(lo) if hi is None else f'in {lo}..{hi}'}")
+        return int(value)
+    return check
+
+
+def _number(lo: float, *, strict: bool, hi: float | None = None) -> Callable[[Any], float]:
+    def check(value):
+        ok = (not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
+              and (value > lo if strict else value >= lo) and (hi is None or value <= hi))
+        if not ok:
+            bound = f"{'>' if strict else '>='} {lo:g}" + ("" if hi is None else f" and <= {hi:g}")
+            raise _Bad(f"expected a finite number {bound}")
+        return float(value)
+    return check
+
+
+def _choice(options) -> Callable[[Any], str]:
+    def check(value):
+        if value not in options:
+            raise _Bad(f"expected one of {', '.join(options)}")
+        return value
+    return check
+
+
+def _text(value) -> str:
+    if not isinstance(value, str) or not value:
+        raise _Bad("expected a non-empty string")
+    return value
+
+
+def _shape_set(value) -> tuple[str, ...]:
+    shapes = [value] if isinstance(value, str) else value
+    if not isinstance(shapes, list) or not shapes or any(s not in HOLE_SHAPES for s in shapes):
+        raise _Bad(f"expected hole shapes among {', '.join(HOLE_SHAPES)}")
+    return tuple(sorted(set(shapes)))
+
+
+def _landmarks(value):
+    if value == "auto":
+        return value
+    if isinstance(value, bool) or not isinstance(value, int) or value < 3:
+        raise _Bad('expected an integer >= 3 or "auto"')
+    return int(value)
+
+
+@dataclass(frozen=True)
+class Param:
+    """One grid key: its table, default, check, and SQL type of its store column."""
+
+    table: str
+    name: str
+    default: Any
+    check: Callable[[Any], Any]
+    sql: str
+
+
+PARAMS: tuple[Param, ...] = (
+    Param("arena", "generator", "random", _choice(tuple(GENERATORS)), "TEXT"),
+    Param("arena", "holes", 1, _integer(0), "INTEGER"),
+    Param("arena", "shapes", ("square",), _shape_set, "TEXT[]"),
+    Param("arena", "outer", "square", _choice(OUTER_SHAPES), "TEXT"),
+    Param("arena", "scale", 1.0, _number(0.0, strict=True), "DOUBLE"),
+    Param("arena", "r_outer", 250.0, _number(0.0, strict=True), "DOUBLE"),
+    Param("arena", "r_inner", 150.0, _number(0.0, strict=True), "DOUBLE"),
+    Param("arena", "path", None, _text, "TEXT"),
+    Param("swarm", "agents", 200, _integer(1), "INTEGER"),
+    Param("swarm", "duration", 20.0, _number(0.0, strict=True), "DOUBLE"),
+    Param("swarm", "static_fraction", 0.0, _number(0.0, strict=False, hi=1.0), "DOUBLE"),
+    Param("swarm", "static_time", 0.0, _number(0.0, strict=False), "DOUBLE"),
+    Param("map", "metric", "hybrid", _choice(METRICS), "TEXT"),
+    Param("map", "subsample", "maxmin", _choice(tuple(SUBSAMPLERS)), "TEXT"),
+    Param("map", "landmarks", "auto", _landmarks, "INTEGER"),
+    Param("map", "max_landmarks", MapConfig().max_landmarks, _integer(3), "INTEGER"),
+    Param("map", "maxdim", 1, _integer(1, 2), "INTEGER"),
+    Param("map", "classifier", "default", _text, "TEXT"),
+)
+"""Every grid key, in expansion order (the last key varies fastest)."""
+GRID_TABLES = ("arena", "swarm", "map")
+SWEEP_KEYS = ("name", "replicates", "salt")
+
+
+@dataclass(frozen=True)
+class Job:
+    """One simulate-and-map job: a canonical configuration and a replicate index.
+
+    Attributes
+    ----------
+    sweep
+        Name of the sweep that asked for it (a label: not part of the key).
+    config_json
+        Canonical JSON of the configuration (sorted keys, defaults filled in).
+    replicate
+        Replicate index r = 0 .. replicates - 1.
+    salt
+        The sweep's salt (part of the key and seed).
+    files
+        ``(key, absolute path)`` of the job's input files (``arena.path``,
+        ``map.classifier``); not part of the key, whose config holds their SHA-256.
+    """
+
+    sweep: str
+    config_json: str
+    replicate: int
+    salt: str = ""
+    files: tuple[tuple[str, str], ...] = ()
+
+    @property
+    def config(self) -> dict[str, Any]:
+        """The canonical configuration as a fresh dict."""
+        return json.loads(self.config_json)
+
+    @property
+    def key(self) -> str:
+        """Hex SHA-256 of the canonical JSON of (config, replicate, salt): the job's identity."""
+        return self._digest().hex()
+
+    @property
+    def seed(self) -> int:
+        """64-bit seed: the first 8 bytes of the key's hash, as an unsigned integer."""
+        return int.from_bytes(self._digest()[:8], "big")
+
+    def stream_seeds(self) -> dict[str, int]:
+        """Independent seeds of the job's streams (``STREAMS``), spawned from
+        ``SeedSequence(seed)``: one 64-bit integer each."""
+        children = np.random.SeedSequence(self.seed).spawn(len(STREAMS))
+        return {name: int(child.generate_state(1, np.uint64)[0]) for name, child in zip(STREAMS, children)}
+
+    def file(self, key: str) -> str | None:
+        """Absolute path of the input file of ``key`` (``"arena.path"`` or
+        ``"map.classifier"``); None if the job has none."""
+        return dict(self.files).get(key)
+
+    def _digest(self) -> bytes:
+        identity = {"config": json.loads(self.config_json), "replicate": self.replicate, "salt": self.salt}
+        return hashlib.sha256(canonical_json(identity).encode()).digest()
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """A parsed sweep file: its name, salt, replicates and the jobs of its grid."""
+
+    name: str
+    salt: str
+    replicates: int
+    jobs: tuple[Job, ...]
+    source: str
+
+
+def canonical_json(obj) -> str:
+    """Compact JSON with sorted keys: the byte-stable form hashed into job keys."""
+    return json.dumps(obj, sort_keys=True, separators=(",", ":"), ensure_ascii=False, allow_nan=False)
+
+
+def read_sweep(path) -> Sweep:
+    """Parse a sweep TOML file and expand its grid.
+
+    Raises
+    ------
+    InputError
+        On a syntax error, an unknown table or key, a wrong type or an out-of-range
+        value: one line naming the file, the key and the value.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise InputError("file not found", file=str(path)) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read file ({exc})", file=str(path)) from None
+    try:
+        document = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"invalid TOML: {exc}", file=str(path)) from None
+    return expand_grid(document, source=str(path), base_dir=path.parent, default_name=path.stem)
+
+
+def expand_grid(document: dict, *, source: str = "<grid>", base_dir=None,
+                default_name: str = "sweep") -> Sweep:
+    """Expand a parsed sweep document (the TOML as a dict) into its jobs.
+
+    Parameters
+    ----------
+    document
+        ``{"sweep": {...}, "arena": {...}, "swarm": {...}, "map": {...}}``, every table
+        optional (see the module docstring).
+    source
+        Name used in error messages (the file).
+    base_dir
+        Folder that relative input paths are relative to (default: the working folder).
+    default_name
+        Sweep name when ``[sweep] name`` is absent.
+    """
+    def fail(where: str, message: str):
+        raise InputError(f"{where}: {message}", file=source)
+
+    base_dir = Path(base_dir) if base_dir is not None else Path.cwd()
+    for table, body in document.items():
+        if table not in ("sweep", *GRID_TABLES):
+            fail(f"[{table}]", f"unknown table; expected sweep, {', '.join(GRID_TABLES)}")
+        if not isinstance(body, dict):
+            fail(f"[{table}]", f"expected a table, got {_toml(body)}")
+
+    head = document.get("sweep", {})
+    for key in head:
+        if key not in SWEEP_KEYS:
+            fail(f"[sweep] {key}", f"unknown key; expected one of {', '.join(SWEEP_KEYS)}")
+    name = _scalar(head, "name", default_name, _text, fail)
+    salt = head.get("salt", "")
+    if not isinstance(salt, str):
+        fail(f"[sweep] salt = {_toml(salt)}", "expected a string")
+    replicates = _scalar(head, "replicates", 1, _integer(1), fail)
+
+    known = {(p.table, p.name) for p in PARAMS}
+    for table in GRID_TABLES:
+        for key in document.get(table, {}):
+            if (table, key) not in known:
+                names = ", ".join(p.name for p in PARAMS if p.table == table)
+                fail(f"[{table}] {key}", f"unknown key; expected one of {names}")
+    axes = [_axis(document.get(param.table, {}), param, fail) for param in PARAMS]
+
+    inputs = _InputFiles(base_dir, fail)
+    configs: dict[str, tuple[tuple[str, str], ...]] = {}
+    used: set[tuple[str, str]] = set()
+    for values in itertools.product(*axes):
+        point = {(p.table, p.name): v for p, v in zip(PARAMS, values)}
+        config, files, keys = _canonical(point, inputs, fail)
+        used |= keys
+        configs.setdefault(canonical_json(config), files)
+    for table in GRID_TABLES:
+        for key in document.get(table, {}):
+            if (table, key) not in used:
+                fail(f"[{table}] {key}", _unused_reason(table, key, document))
+
+    jobs = tuple(Job(sweep=name, config_json=config, replicate=r, salt=salt, files=files)
+                 for config, files in configs.items() for r in range(replicates))
+    return Sweep(name=name, salt=salt, replicates=replicates, jobs=jobs, source=source)
+
+
+def flat_columns(config: dict) -> dict[str, Any]:
+    """One value per ``PARAMS`` key (None where the config does not use it; ``landmarks``
+    None for "auto"): the store's flattened grid columns."""
+    flat = {}
+    for p in PARAMS:
+        value = config.get(p.table, {}).get(p.name)
+        flat[p.name] = None if value == "auto" else value
+    return flat
+
+
+# -- internals ----------------------------------------------------------------------------
+def _scalar(table: dict, key: str, default, check, fail):
+    if key not in table:
+        return default
+    try:
+        return check(table[key])
+    except _Bad as exc:
+        fail(f"[sweep] {key} = {_toml(table[key])}", str(exc))
+
+
+def _axis(table: dict, param: Param, fail) -> list[Any]:
+    """The values of one grid key: the checked scalar, or each element of a list."""
+    if param.name not in table:
+        return [param.default]
+    raw = table[param.name]
+    if param.name == "shapes":  # a string or list of strings is one set; a list of lists, a grid
+        values = raw if isinstance(raw, list) and raw and all(isinstance(v, list) for v in raw) else [raw]
+    else:
+        values = raw if isinstance(raw, list) else [raw]
+    if not values:
+        fail(f"[{param.table}] {param.name} = []", "empty list; give at least one value")
+    checked = []
+    for value in values:
+        try:
+            checked.append(param.check(value))
+        except _Bad as exc:
+            fail(f"[{param.table}] {param.name} = {_toml(value)}", str(exc))
+    return list(dict.fromkeys(checked))
+
+
+class _InputFiles:
+    """Input files of the grid: absolute path and SHA-256 of each, read and checked once."""
+
+    def __init__(self, base_dir: Path, fail):
+        self.base_dir, self.fail, self.seen = base_dir, fail, {}
+
+    def resolve(self, where: str, written: str, load: Callable[[Path], Any]) -> tuple[str, str]:
+        """(absolute path, SHA-256) of the file; ``load(path)`` must accept it (its
+        SwarmtopoError becomes the message)."""
+        if written not in self.seen:
+            path = (self.base_dir / written).resolve()
+            try:
+                digest = hashlib.sha256(path.read_bytes()).hexdigest()
+                load(path)
+            except OSError as exc:
+                self.fail(f"{where} = {_toml(written)}", f"cannot read {path} ({exc.strerror or exc})")
+            except SwarmtopoError as exc:
+                self.fail(f"{where} = {_toml(written)}", str(exc))
+            self.seen[written] = (str(path), digest)
+        return self.seen[written]
+
+
+def _canonical(point: dict, inputs: _InputFiles, fail):
+    """(canonical config, input files, keys used) of one grid point."""
+    generator = point[("arena", "generator")]
+    arena = {"generator": generator}
+    for name in GENERATORS[generator]:
+        arena[name] = list(point[("arena", name)]) if name == "shapes" else point[("arena", name)]
+    files = []
+    if generator == "file":
+        if arena["path"] is None:
+            fail("[arena] path", 'missing: generator = "file" needs the path of a GeoJSON arena')
+        absolute, arena["path_sha256"] = inputs.resolve("[arena] path", arena["path"], read_arena)
+        files.append(("arena.path", absolute))
+    if generator == "annulus" and arena["r_inner"] >= arena["r_outer"]:
+        fail(f"[arena] r_inner = {_toml(arena['r_inner'])}", f"must be smaller than r_outer = {arena['r_outer']:g}")
+
+    swarm = {name: point[("swarm", name)] for name in ("agents", "duration", "static_fraction")}
+    if swarm["static_fraction"] > 0:
+        swarm["static_time"] = point[("swarm", "static_time")]
+        if swarm["static_time"] > swarm["duration"]:
+            fail(f"[swarm] static_time = {_toml(swarm['static_time'])}",
+                 f"after the end of the run (duration = {swarm['duration']:g} s)")
+
+    mapping = {name: point[("map", name)] for name in ("metric", "subsample", "landmarks", "maxdim", "classifier")}
+    if mapping["landmarks"] == "auto":
+        mapping["max_landmarks"] = point[("map", "max_landmarks")]
+    if mapping["classifier"] not in PRESETS:
+        absolute, mapping["classifier_sha256"] = inputs.resolve("[map] classifier", mapping["classifier"],
+                                                               load_classifier)
+        files.append(("map.classifier", absolute))
+
+    config = {"arena": arena, "swarm": swarm, "map": mapping}
+    used = {(table, key) for table, body in config.items() for key in body}
+    return config, tuple(files), used
+
+
+def _unused_reason(table: str, key: str, document: dict) -> str:
+    if table == "arena":
+        generators = document["arena"].get("generator", "random")
+        generators = generators if isinstance(generators, list) else [generators]
+        users = [g for g, keys in GENERATORS.items() if key in keys]
+        return (f"not used by generator {', '.join(repr(g) for g in generators)} "
+                f"(only by {', '.join(repr(g) for g in users)})")
+    if key == "static_time":
+        return "not used: static_fraction is 0 (no agent stops for good)"
+    return 'not used: landmarks is a number (max_landmarks caps landmarks = "auto")'
+
+
+def _toml(value) -> str:
+    """A value as it would be written in TOML (for messages)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, list):
+        return "[" + ", ".join(_toml(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k} = {_toml(v)}" for k, v in value.items()) + "}"
+    return str(value)
