@@ -58,6 +58,11 @@ def test_map_writes_map_json_and_figures(tmp_path, simulated):
     assert doc["classifier"]["classifier"] == "default"
     assert doc["betti"]["0"] == 1
     assert doc["params"]["landmarks"] == 200
+    # one loop of landmark events round each counted hole, with valid event indices
+    region = doc["regions"][0]
+    assert len(region["cycles"]) == region["betti"]["1"]
+    n_events = read_log(simulated[0]).n_events
+    assert all(0 <= e < n_events for c in region["cycles"] for e in c["events"])
     assert f"beta_1 = {doc['betti']['1']}" in proc.stdout
     # infinite bars are written as null, one per region
     assert [d for _, d in doc["diagrams"]["0"]].count(None) == doc["betti"]["0"]
@@ -90,6 +95,9 @@ def test_demo_prints_recovered_and_true_betti_numbers(tmp_path):
         in proc.stdout
     assert "true:      beta_0 = 1, beta_1 = 1" in proc.stdout
     assert (tmp_path / "demo" / "map.json").exists() and (tmp_path / "demo" / "log" / "events.csv").exists()
+    # the report carries the swarm animation from the demo's sampled trajectories
+    html = (tmp_path / "demo" / "report.html").read_text(encoding="utf-8")
+    assert "The swarm" in html and '"frames"' in html
 
 
 def test_bad_events_file_is_one_line_naming_file_row_column_value(tmp_path):
@@ -148,7 +156,20 @@ def test_bad_option_values(simulated, tmp_path):
     assert_one_line_error(run("simulate", "--format", "xml", "--out", tmp_path / "y"), "xml", code=2)
 
 
-@pytest.mark.parametrize("command", ["simulate", "map", "demo"])
+@pytest.mark.parametrize("command", ["simulate", "ingest", "map", "demo", "sweep", "reproduce"])
 def test_help_shows_an_example(command):
     proc = run(command, "--help")
     assert proc.returncode == 0 and "Example: swarmtopo" in proc.stdout
+
+
+def test_quiet_verbose_and_pipes(tmp_path, simulated):
+    # in a pipe a normal run prints its verdict and no progress; --quiet prints nothing
+    normal = run("map", simulated[0], "--out", tmp_path / "n", "--landmarks", 100)
+    assert normal.returncode == 0 and "recovered:" in normal.stdout and normal.stderr == ""
+    quiet = run("map", simulated[0], "--out", tmp_path / "q", "--landmarks", 100, "--quiet")
+    assert quiet.returncode == 0 and quiet.stdout == "" and quiet.stderr == ""
+    # --verbose adds each stage's time and each region's details on stderr, same result
+    verbose = run("map", simulated[0], "--out", tmp_path / "v", "--landmarks", 100, "--verbose")
+    assert verbose.returncode == 0 and verbose.stdout == normal.stdout.replace(str(tmp_path / "n"), str(tmp_path / "v"))
+    assert "stages: graph" in verbose.stderr and "region 0:" in verbose.stderr
+    assert_one_line_error(run("map", simulated[0], "-q", "-v"), "--quiet and --verbose exclude each other", code=2)

@@ -343,12 +343,12 @@ def test_one_local_worker_and_two_scheduler_workers_give_identical_tables(tmp_pa
 def _interrupt_after_first_row(sweep_file, store, sig, *extra):
     """Run `swarmtopo sweep`, send ``sig`` once the first row is written; (process, rest of stderr)."""
     proc = subprocess.Popen([sys.executable, "-m", "swarmtopo", "sweep", str(sweep_file), "--store", str(store),
-                             *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                             "--verbose", *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True)
     watchdog = threading.Timer(240, _stop, [proc])  # the suite must never hang
     watchdog.start()
     try:
-        for line in proc.stderr:  # not a terminal: one line per finished job
+        for line in proc.stderr:  # --verbose: one line per finished job
             if line.startswith("1/8 jobs done"):
                 break
         os.kill(proc.pid, sig)

@@ -28,6 +28,17 @@ app = typer.Typer(
 )
 out = Console()
 err = Console(stderr=True)
+VERBOSE_HELP = "Also report each stage's details and timings on stderr (in pipes too)."
+
+
+def _check_verbosity(quiet: bool, verbose: bool) -> None:
+    if quiet and verbose:
+        raise typer.BadParameter("--quiet and --verbose exclude each other")
+
+
+def _detail(message: str) -> None:
+    """One --verbose line on stderr."""
+    err.print(message, markup=False, highlight=False, soft_wrap=True)
 
 
 def _fmt_option(value: str) -> str:
@@ -66,24 +77,79 @@ def simulate(
     trajectories: Optional[float] = typer.Option(None, "--trajectories", help="Also write positions every EVERY s."),
     fmt: str = typer.Option("csv", "--format", callback=_fmt_option, help="csv or parquet."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar, no summary."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
     """Simulate a swarm in an arena and write its encounter log folder."""
+    import time
+
     from .arena import random_arena
     from .io import read_arena, write_log
     from .sim import SensingParams, simulate as run
 
+    _check_verbosity(quiet, verbose)
+
     # The arena draws from its own stream, spawned from the seed; the swarm uses the seed.
     world = read_arena(arena) if arena else random_arena(holes, scale=scale, rng=np.random.SeedSequence(seed).spawn(1)[0])
+    if verbose:
+        _detail(f"arena: {world.betti[0]} region(s), {world.betti[1]} hole(s), area {world.area:.0f} mm^2; "
+                f"{agents} agents, {duration:g} s, dt {dt:g} s, r_d {rd:g} mm, seed {seed}")
+    start = time.perf_counter()
     with _progress("simulating", quiet) as tick:
         sim = run(world, agents, duration, dt=dt, sensing=SensingParams(r_d=rd), rng=seed,
                   static_fraction=static_fraction, static_time=static_time, truth=truth,
                   trajectory_every=trajectories, progress=tick)
+    if verbose:
+        _detail(f"simulated in {time.perf_counter() - start:.2f} s: {sim.log.n_events} encounters, "
+                f"{len(sim.log.status_t)} status changes")
     written = write_log(sim.log, out_dir, fmt=fmt, truth=sim.truth, trajectories=sim.trajectories, arena=world)
     if not quiet:
         b0, b1 = world.betti
         out.print(f"{sim.log.n_events} encounters of {agents} agents over {duration:g} s "
                   f"in an arena with {b0} region(s) and {b1} hole(s)")
         out.print(f"wrote {', '.join(str(p) for p in written)}")
+
+
+@app.command(epilog="Example: swarmtopo ingest primaryschool.csv --format sociopatterns --out runs/school "
+                    "&& swarmtopo map runs/school")
+def ingest(
+    trace: Path = typer.Argument(..., help="Proximity trace file."),
+    fmt: str = typer.Option(..., "--format",
+                            help="csv | parquet | sociopatterns (t i j Ci Cj) | one (ONE CONN events)."),
+    out_dir: Path = typer.Option(..., "--out", help="Log folder to write (created); swarmtopo map reads it."),
+    skip_bad: bool = typer.Option(False, "--skip-bad",
+                                  help="Skip malformed lines and count them (default: stop at the first)."),
+    time_column: str = typer.Option("t", "--time-column", help="csv/parquet: column of encounter times (s)."),
+    a_column: str = typer.Option("a", "--a-column", help="csv/parquet: column of the first agent ID."),
+    b_column: str = typer.Option("b", "--b-column", help="csv/parquet: column of the second agent ID."),
+    window: float = typer.Option(20.0, "--contact-window",
+                                 help="sociopatterns: seconds of one contact window (a line at t covers (t-w, t])."),
+    log_fmt: str = typer.Option("csv", "--log-format", callback=_fmt_option, help="Log folder tables: csv or parquet."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
+) -> None:
+    """Convert a proximity trace into an encounter log folder (see docs/real-data.md)."""
+    from .ingest import FORMATS, ingest as read_trace
+    from .io import write_log
+
+    _check_verbosity(quiet, verbose)
+    if fmt not in FORMATS:
+        raise typer.BadParameter(f"{fmt!r} is not one of {', '.join(FORMATS)}", param_hint="--format")
+    log, report = read_trace(trace, fmt, skip_bad=skip_bad, time_column=time_column, a_column=a_column,
+                             b_column=b_column, window=window)
+    written = write_log(log, out_dir, fmt=log_fmt)
+    if verbose:
+        _detail(f"ingest report: {report.as_meta()}")
+    if not quiet:
+        out.print(f"{report.lines} lines of {trace}: {log.n_events} encounters of {log.n_agents} agents "
+                  f"over {log.duration:g} s", markup=False, highlight=False)
+        if skip_bad:
+            out.print(f"skipped {report.skipped} malformed line(s)", markup=False, highlight=False)
+            for message in report.examples:
+                out.print(f"  {message}", markup=False, highlight=False, soft_wrap=True)
+        notes = ", ".join(f"{k.replace('_', ' ')}: {v}" for k, v in report.counts.items() if v)
+        if notes:
+            out.print(notes, markup=False, highlight=False)
+        out.print(f"wrote {', '.join(str(p) for p in written)}", markup=False, highlight=False)
 
 
 def _parse_window(text: Optional[str]):
@@ -118,18 +184,22 @@ def map_command(
         "default", "--classifier",
         help="Betti classifier: default (trained by the project), paper (the paper's Theta*), or a JSON file."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
     """Map an encounter log folder: Betti numbers with confidence, diagrams and pictures."""
     from .classify import load_classifier
     from .io import read_log
     from .pipeline import MapConfig
 
+    _check_verbosity(quiet, verbose)
     out_dir = out_dir or log_dir / "map"
     model = load_classifier(classifier)
     log = read_log(log_dir)
     config = MapConfig(metric=metric, subsample=subsample, landmarks=landmarks,
                        window=window, maxdim=maxdim, seed=seed)
-    tmap, written = _run_map(log, config, log_dir, out_dir, quiet, classifier=model)
+    if verbose:
+        _detail(f"log {log_dir}: {log.n_events} encounters of {log.n_agents} agents over {log.duration:g} s")
+    tmap, written = _run_map(log, config, log_dir, out_dir, quiet, verbose, classifier=model)
     if not quiet:
         _print_verdict(tmap, truth=None)
         out.print(f"wrote {', '.join(str(p) for p in written)}")
@@ -140,6 +210,7 @@ def demo(
     out_dir: Path = typer.Option(Path("swarmtopo-demo"), "--out", help="Output folder."),
     seed: int = typer.Option(0, "--seed", help="Random seed."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
     """Simulate the paper's Fig. "encmds" scenario and map it.
 
@@ -151,12 +222,15 @@ def demo(
     from .pipeline import MapConfig
     from .sim import simulate as run
 
+    _check_verbosity(quiet, verbose)
     world = default_arena()
     with _progress("simulating", quiet) as tick:
         sim = run(world, 200, 20.0, rng=seed, truth=True, trajectory_every=0.5, progress=tick)
     log_dir = out_dir / "log"
     write_log(sim.log, log_dir, truth=sim.truth, trajectories=sim.trajectories, arena=world)
-    tmap, written = _run_map(sim.log, MapConfig(seed=seed), log_dir, out_dir, quiet)
+    if verbose:
+        _detail(f"simulated: {sim.log.n_events} encounters of 200 agents over 20 s; log: {log_dir}")
+    tmap, written = _run_map(sim.log, MapConfig(seed=seed), log_dir, out_dir, quiet, verbose)
     if not quiet:
         _print_verdict(tmap, truth=world.betti)
         out.print(f"log: {log_dir}")
@@ -173,6 +247,7 @@ def sweep(
     workers: Optional[int] = typer.Option(None, "--workers", min=1,
                                           help="Worker processes of the local cluster (default: all cores)."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
     """Run every simulate-and-map job of a grid on Dask and store one row per job.
 
@@ -181,9 +256,13 @@ def sweep(
     from .experiments.grid import read_sweep
     from .experiments.sweep import run_sweep
 
+    _check_verbosity(quiet, verbose)
     grid = read_sweep(config)
+    if verbose:
+        _detail(f"sweep {grid.name!r} from {config}: {len(grid.jobs)} jobs ({grid.replicates} replicate(s), "
+                f"salt {grid.salt!r})")
     try:
-        with _sweep_progress(quiet) as tick:
+        with _sweep_progress(quiet, verbose) as tick:
             summary = run_sweep(grid.jobs, store, scheduler=scheduler, workers=workers, progress=tick)
     except KeyboardInterrupt:
         if not quiet:
@@ -216,18 +295,20 @@ def reproduce(
     workers: Optional[int] = typer.Option(None, "--workers", min=1, help="clust: local Dask worker processes."),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help="clust: address of an existing Dask scheduler."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
     """Reproduce one of the paper's experiments: PNG figures, NAME.csv (one row per run),
     NAME.md (summary table) and NAME.json (summary and settings) in the output folder."""
     from .experiments.reproduce import REPRODUCTIONS, reproduce as run
 
+    _check_verbosity(quiet, verbose)
     if name not in REPRODUCTIONS:
         raise typer.BadParameter(f"{name!r} is not one of {', '.join(REPRODUCTIONS)}", param_hint="NAME")
     if name != "clust" and (workers is not None or scheduler is not None):
         raise typer.BadParameter("--workers and --scheduler apply to clust only (the others run in this process)")
     out_dir = out_dir or Path("reproduction") / name
     options = {"workers": workers, "scheduler": scheduler} if name == "clust" else {}
-    with _sweep_progress(quiet, label=name) as tick:
+    with _sweep_progress(quiet, verbose, label=name) as tick:
         result = run(name, out_dir, runs=runs, progress=tick, **options)
     if not quiet:
         out.print(result.table_markdown, markup=False, highlight=False)
@@ -236,12 +317,13 @@ def reproduce(
 
 
 @contextmanager
-def _sweep_progress(quiet: bool, label: str = "sweep"):
-    """progress(done, total, failed): a Rich bar on a terminal, a line per job in pipes."""
-    if quiet:
+def _sweep_progress(quiet: bool, verbose: bool = False, label: str = "sweep"):
+    """progress(done, total, failed): a Rich bar on a terminal; with --verbose a line per
+    finished job instead (in pipes too); nothing otherwise."""
+    if quiet or (not verbose and not err.is_terminal):
         yield lambda done, total, failed: None
         return
-    if not err.is_terminal:
+    if verbose:
         def line(done, total, failed):
             if done:
                 err.print(f"{done}/{total} jobs done ({failed} failed)", markup=False, highlight=False)
@@ -254,7 +336,7 @@ def _sweep_progress(quiet: bool, label: str = "sweep"):
         yield lambda done, total, failed: bar.update(task, completed=done, total=total, failed=failed)
 
 
-def _run_map(log, config, log_dir: Path, out_dir: Path, quiet: bool, classifier=None):
+def _run_map(log, config, log_dir: Path, out_dir: Path, quiet: bool, verbose: bool = False, classifier=None):
     """Map, write map.json and figures; ground truth beside the log only colours pictures,
     and a broken ground-truth file costs a warning, never the map."""
     from .pipeline import STAGES, map_encounters
@@ -264,26 +346,46 @@ def _run_map(log, config, log_dir: Path, out_dir: Path, quiet: bool, classifier=
         tmap = map_encounters(log, config, classifier=classifier,
                               progress=lambda stage: tick(STAGES.index(stage) / len(STAGES)))
         tick(1.0)
-    arena, truth = _ground_truth(log, log_dir, quiet)
-    return tmap, write_map_outputs(tmap, out_dir, log=log, truth=truth, arena=arena)
+    if verbose:
+        _map_details(tmap)
+    arena, truth, trajectories = _ground_truth(log, log_dir, quiet)
+    return tmap, write_map_outputs(tmap, out_dir, log=log, truth=truth, arena=arena, trajectories=trajectories)
+
+
+def _map_details(tmap) -> None:
+    """--verbose: each stage's time and each region's landmarks, scales, bars and loops."""
+    _detail("stages: " + ", ".join(f"{stage} {seconds:.2f} s" for stage, seconds in tmap.timings.items()))
+    for r in tmap.regions:
+        longest = ", ".join(f"{x:.3g}" for x in r.diagram.lengths(1)[:4]) if r.diagram.maxdim >= 1 else "-"
+        _detail(f"region {r.component}: {r.n_events} events, {r.n_agents} agents, "
+                f"{len(r.landmarks.nodes)} landmarks (covering radius {r.scales.cover_radius:.3g} s, "
+                f"k-NN scale {r.scales.knn:.3g} s); longest H1 bars {longest} s; "
+                f"threshold {', '.join(f'{v:.3g} s' for v in r.thresholds.values())}; "
+                f"{len(r.cycles)} loop(s) found")
 
 
 def _ground_truth(log, log_dir: Path, quiet: bool):
-    from .io import read_arena, read_truth
+    """(arena, truth, trajectories) beside the log, each None when absent or broken
+    (a broken file costs a warning: ground truth only draws pictures)."""
+    from .io import read_arena, read_trajectories, read_truth
 
-    arena = truth = None
+    arena = truth = trajectories = None
     try:
         if (log_dir / "arena.geojson").exists():
             arena = read_arena(log_dir / "arena.geojson")
         truth = read_truth(log_dir)
     except SwarmtopoError as exc:
         _warn(f"ground truth ignored for pictures: {exc}", quiet)
-        return arena, None
+        return arena, None, None
     if truth is not None and not _aligned(truth, log):
         _warn(f"ground truth ignored for pictures: {log_dir / 'truth'}.* rows do not match the events "
               "one for one (same order, same t, a, b)", quiet)
         truth = None
-    return arena, truth
+    try:
+        trajectories = read_trajectories(log_dir)
+    except SwarmtopoError as exc:
+        _warn(f"trajectories ignored (no swarm animation in the report): {exc}", quiet)
+    return arena, truth, trajectories
 
 
 def _aligned(truth, log) -> bool:

@@ -28,6 +28,7 @@ import numpy as np
 
 from . import __version__
 from .classify import BettiClassifier, RegionScales, load_classifier
+from .cycles import Cycle, region_cycles
 from .embed import Embedding, mds
 from .errors import SwarmtopoError
 from .graph import METRICS, EncounterGraph, build_graph
@@ -45,7 +46,7 @@ AUTO_COVER_FACTOR = 1.5
 region's k-NN scale).  The landmarks' diagram is within bottleneck 2 r_cover of the
 whole cloud's, so subsampling moves no bar by more than 3 s: the order of the
 cloud's own Rips noise bars."""
-STAGES = ("graph", "landmarks", "persistence", "embedding", "classify")
+STAGES = ("graph", "landmarks", "persistence", "embedding", "classify", "cycles")
 """Stage names passed to ``map_encounters``'s progress callback, in order."""
 
 
@@ -85,6 +86,9 @@ class MapConfig:
         map).  It also needs ``MIN_REGION_AGENTS`` distinct agents.
     embed_dim
         Dimension of the MDS picture: 3, 2, or 0 for no picture (sweeps).
+    cycles
+        Find a representative loop of landmarks for each counted H1 bar (where the
+        holes are; :mod:`swarmtopo.cycles`).  Off in sweeps, which store no loops.
     """
 
     metric: str = "hybrid"
@@ -99,6 +103,7 @@ class MapConfig:
     omega: float = 1.0
     min_region_events: int = 50
     embed_dim: int = 3
+    cycles: bool = True
 
     def validate(self) -> "MapConfig":
         if self.metric not in METRICS:
@@ -138,6 +143,7 @@ class RegionMap:
     thresholds: dict[int, float]  # bar-length threshold per dimension n >= 1
     betti: dict[int, int]
     confidence: dict[int, float | None]  # P(betti[n] is right), n >= 1
+    cycles: list[Cycle]  # a loop of landmarks round each counted H1 bar (empty if not asked)
     warnings: list[str]
     embedding: Embedding | None
 
@@ -190,6 +196,7 @@ class TopologicalMap:
                     "thresholds": {str(n): float(v) for n, v in r.thresholds.items()},
                     "betti": {str(k): int(v) for k, v in sorted(r.betti.items())},
                     "confidence": {str(k): v for k, v in sorted(r.confidence.items())},
+                    "cycles": [c.to_json() for c in r.cycles],
                     "diagrams": r.diagram.to_json(),
                     "mds_stress": None if r.embedding is None else float(r.embedding.stress),
                     "warnings": r.warnings,
@@ -298,9 +305,15 @@ def map_encounters(
             thresholds=thresholds,
             betti=betti_region,
             confidence=confidence_region,
+            cycles=[],
             warnings=_sampling_warnings(scales, len(land.nodes), config),
             embedding=emb,
         ))
+        if config.cycles:
+            say("cycles")
+            t0 = time.perf_counter()
+            regions[-1].cycles = region_cycles(regions[-1])
+            timings["cycles"] += time.perf_counter() - t0
 
     betti: dict[int, int | None] = {0: len(regions)}
     confidence: dict[int, float | None] = {0: classifier.beta0_confidence()}

@@ -239,3 +239,20 @@ def plot_scores_by(values, series: dict, ax=None, *, xlabel: str, ylabel: str, t
     if title:
         ax.set_title(title, fontsize=9)
     return ax
+
+
+def plot_cycles(arena, loops, ax=None, *, correct=None, title=None):
+    """Representative cycles drawn at the true positions of their events on the arena.
+
+    ``loops`` is a list of (k, 2) arrays of true positions in loop order (closed
+    here); ``correct`` optionally flags each loop (green if it encircles exactly one
+    obstacle, orange otherwise); without it loops take the tab10 colours.
+    """
+    ax = plot_arena(arena, ax, title=title or "representative cycles at true positions")
+    for k, loop in enumerate(loops):
+        loop = np.asarray(loop, dtype=float)
+        closed = np.vstack([loop, loop[:1]])
+        color = f"C{k % 10}" if correct is None else ("tab:green" if correct[k] else "tab:orange")
+        ax.plot(closed[:, 0], closed[:, 1], "-", color=color, lw=2, zorder=3)
+        ax.scatter(loop[:, 0], loop[:, 1], color=color, s=18, edgecolor="k", lw=0.5, zorder=4)
+    return ax

@@ -1,4 +1,4 @@
-"""What ``swarmtopo map`` and ``swarmtopo demo`` write: map.json and PNG figures.
+"""What ``swarmtopo map`` and ``swarmtopo demo`` write: map.json, report.html and PNG figures.
 
 Ground truth (true positions, the arena) only colours pictures here; it never
 reaches :func:`swarmtopo.pipeline.map_encounters`.
@@ -13,19 +13,25 @@ import numpy as np
 from .io import write_json
 from .log import EncounterLog
 from .pipeline import TopologicalMap
+from .report_html import write_report
 
 
 def write_map_outputs(tmap: TopologicalMap, out_dir: Path, *, log: EncounterLog,
-                      truth: dict[str, np.ndarray] | None = None, arena=None) -> list[Path]:
-    """Write map.json, diagram.png and (with an MDS picture) cloud.png; return the paths."""
+                      truth: dict[str, np.ndarray] | None = None, arena=None,
+                      trajectories: dict[str, np.ndarray] | None = None) -> list[Path]:
+    """Write map.json, report.html, diagram.png and (with an MDS picture) cloud.png; return the paths.
+
+    ``trajectories`` (``io.read_trajectories``) adds the swarm animation to the report.
+    """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    written = [out_dir / "map.json", out_dir / "diagram.png"]
+    written = [out_dir / "map.json", out_dir / "report.html", out_dir / "diagram.png"]
     write_json(tmap.to_json(), written[0])
-    _diagram_figure(tmap).savefig(written[1], dpi=110)
+    write_report(tmap, written[1], log=log, truth=truth, arena=arena, trajectories=trajectories)
+    _diagram_figure(tmap).savefig(written[2], dpi=110)
     if any(r.embedding is not None for r in tmap.regions):
         written.append(out_dir / "cloud.png")
-        _cloud_figure(tmap, log, truth, arena).savefig(written[2], dpi=110)
+        _cloud_figure(tmap, log, truth, arena).savefig(written[-1], dpi=110)
     return written
 
 
@@ -45,7 +51,8 @@ def _diagram_figure(tmap: TopologicalMap):
 
 
 def _cloud_figure(tmap: TopologicalMap, log: EncounterLog, truth, arena):
-    from .plotting import new_figure, plot_arena, plot_point_cloud, position_colors
+    from .cycles import event_positions
+    from .plotting import new_figure, plot_arena, plot_cycles, plot_point_cloud, position_colors
 
     with_truth = truth is not None
     rows = len(tmap.regions)
@@ -69,6 +76,9 @@ def _cloud_figure(tmap: TopologicalMap, log: EncounterLog, truth, arena):
         ax = fig.add_subplot(rows, cols, r * cols + 2, projection="3d" if dim == 3 else None)
         plot_point_cloud(coords, colors, ax, title="coloured by true position")
         if arena is not None:
-            plot_arena(arena, fig.add_subplot(rows, cols, r * cols + 3), points=xy, color=colors,
-                       title="landmark events at true positions")
+            ax = plot_arena(arena, fig.add_subplot(rows, cols, r * cols + 3), points=xy, color=colors,
+                            title="landmark events at true positions" + (", holes' loops" if region.cycles else ""))
+            if region.cycles:
+                plot_cycles(arena, [event_positions(truth, c.events) for c in region.cycles], ax=ax,
+                            title=ax.get_title())
     return fig

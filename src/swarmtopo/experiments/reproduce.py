@@ -513,7 +513,7 @@ def _runs(name: str, runs: int | None) -> int:
 
 
 def _config(metric: str, *, picture: bool, window=None) -> MapConfig:
-    return MapConfig(metric=metric, embed_dim=3 if picture else 0, window=window)
+    return MapConfig(metric=metric, embed_dim=3 if picture else 0, window=window, cycles=False)
 
 
 def _map(log, config: MapConfig) -> tuple[TopologicalMap | None, str]:

@@ -108,7 +108,7 @@ def run_job(job: Job) -> dict[str, Any]:
         landmarks = None if mapping["landmarks"] == "auto" else mapping["landmarks"]
         map_config = MapConfig(metric=mapping["metric"], subsample=mapping["subsample"], landmarks=landmarks,
                                max_landmarks=mapping.get("max_landmarks", MapConfig.max_landmarks),
-                               maxdim=mapping["maxdim"], seed=seeds["map"], embed_dim=0)
+                               maxdim=mapping["maxdim"], seed=seeds["map"], embed_dim=0, cycles=False)
         tmap = map_encounters(sim.log, map_config, classifier=classifier)
     except SwarmtopoError as exc:
         row["error"] = " ".join(str(exc).split())
