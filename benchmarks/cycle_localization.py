@@ -31,7 +31,8 @@ FIGURE = Path(__file__).resolve().parents[1] / "docs" / "figures" / "cycles.png"
 
 
 def one_map(n_holes: int, seed: int, duration: float):
-    """(arena, truth, {position: list of (cycle, loop_xy, encircled)}, map seconds, cycle seconds)."""
+    """(arena, estimated beta_1, {position: list of (cycle, loop_xy, encircled)}, map seconds,
+    cycle seconds per position)."""
     arena = random_arena(n_holes, rng=seed, shapes=("square", "disc"))
     sim = simulate(arena, 200, duration, rng=seed, truth=True)
     t0 = time.perf_counter()

@@ -48,7 +48,8 @@ def main() -> None:
                         scheduler=args.scheduler, workers=args.workers,
                         progress=lambda done, total, failed: print(f"\r{done}/{total} jobs", end="", flush=True))
     print(f"\n{summary}")
-    examples = {name: examples_from_rows(read_jobs(args.store, sweep=s.name)) for name, s in sweeps.items()}
+    rows = {name: read_jobs(args.store, sweep=s.name) for name, s in sweeps.items()}
+    examples = {name: examples_from_rows(r) for name, r in rows.items()}
     provenance = {
         "name": "default",
         "script": "scripts/train_classifier.py",
@@ -69,7 +70,7 @@ def main() -> None:
     paper.provenance_["calibration"] = "scripts/train_classifier.py: held-out maps of the default training"
     paper.save(DATA / "classifier-paper.json")
     paper_scores = detection_scores(paper.predict(examples["heldout"].diagrams), examples["heldout"].truth)
-    job_seconds = sum(r["t_total"] for s in sweeps.values() for r in read_jobs(args.store, sweep=s.name))
+    job_seconds = sum(r["t_total"] for sweep_rows in rows.values() for r in sweep_rows)
     write_doc(selection, paper_scores, examples, time.perf_counter() - started, summary, job_seconds)
 
 

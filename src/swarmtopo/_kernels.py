@@ -66,6 +66,30 @@ def _heap_pop(keys, nodes, size):
 
 
 @njit(cache=True)
+def _relax(indptr, indices, weights, u, d, dist, bound, touched, n_touched, heap_keys, heap_nodes, size):
+    """Relax the edges of ``u`` (settled at ``d``): push every neighbour v whose new
+    distance beats both ``dist[v]`` and ``bound[v]`` (pass ``dist`` itself for no bound),
+    recording first-reached nodes in ``touched``.  Returns (heap size, n_touched)."""
+    for e in range(indptr[u], indptr[u + 1]):
+        v = indices[e]
+        nd = d + weights[e]
+        if nd < dist[v] and nd < bound[v]:
+            if dist[v] == np.inf:
+                touched[n_touched] = v
+                n_touched += 1
+            dist[v] = nd
+            size = _heap_push(heap_keys, heap_nodes, size, nd, v)
+    return size, n_touched
+
+
+@njit(cache=True)
+def _restore(dist, touched, n_touched):
+    """Reset the scratch ``dist`` to all +inf (only the touched entries changed)."""
+    for i in range(n_touched):
+        dist[touched[i]] = np.inf
+
+
+@njit(cache=True)
 def settle(indptr, indices, weights, source, count, stop_count,
            dist, touched, heap_keys, heap_nodes, found_node, found_dist):
     """Dijkstra from ``source``, settling nodes in order of distance.
@@ -102,17 +126,9 @@ def settle(indptr, indices, weights, source, count, stop_count,
             counted += count[u]
             if counted >= stop_count:
                 break
-        for e in range(indptr[u], indptr[u + 1]):
-            v = indices[e]
-            nd = d + weights[e]
-            if nd < dist[v]:
-                if dist[v] == np.inf:
-                    touched[n_touched] = v
-                    n_touched += 1
-                dist[v] = nd
-                size = _heap_push(heap_keys, heap_nodes, size, nd, v)
-    for i in range(n_touched):
-        dist[touched[i]] = np.inf
+        size, n_touched = _relax(indptr, indices, weights, u, d, dist, dist, touched, n_touched,
+                                 heap_keys, heap_nodes, size)
+    _restore(dist, touched, n_touched)
     return n_found
 
 
@@ -140,17 +156,9 @@ def lower_distances(indptr, indices, weights, source, to_set, dist, touched, hea
             continue
         to_set[u] = d
         settled += 1
-        for e in range(indptr[u], indptr[u + 1]):
-            v = indices[e]
-            nd = d + weights[e]
-            if nd < dist[v] and nd < to_set[v]:
-                if dist[v] == np.inf:
-                    touched[n_touched] = v
-                    n_touched += 1
-                dist[v] = nd
-                size = _heap_push(heap_keys, heap_nodes, size, nd, v)
-    for i in range(n_touched):
-        dist[touched[i]] = np.inf
+        size, n_touched = _relax(indptr, indices, weights, u, d, dist, to_set, touched, n_touched,
+                                 heap_keys, heap_nodes, size)
+    _restore(dist, touched, n_touched)
     return settled
 
 

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass
+from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 from typing import Any, Sequence
@@ -395,13 +396,20 @@ def load_classifier(name: str | Path) -> BettiClassifier:
     """A shipped classifier by name (``PRESETS``: "default", trained by
     ``scripts/train_classifier.py``; "paper", the paper's Theta*) or a JSON file."""
     if str(name) in PRESETS:
-        text = resources.files("swarmtopo.data").joinpath(f"classifier-{name}.json").read_text("utf-8")
-        return BettiClassifier.from_json(json.loads(text), source=f"swarmtopo/data/classifier-{name}.json")
+        return BettiClassifier.from_json(json.loads(_preset_text(str(name))),
+                                         source=f"swarmtopo/data/classifier-{name}.json")
     path = Path(name)
     if not path.exists():
         raise InputError(f"no such classifier: expected one of {', '.join(PRESETS)} or a JSON file",
                          file=str(path), value=str(name))
     return BettiClassifier.load(path)
+
+
+@lru_cache(maxsize=None)
+def _preset_text(name: str) -> str:
+    """A shipped classifier's JSON, read once per process (every map without an explicit
+    classifier loads the default: a fresh estimator from the cached text)."""
+    return resources.files("swarmtopo.data").joinpath(f"classifier-{name}.json").read_text("utf-8")
 
 
 def paper_classifier() -> BettiClassifier:

@@ -27,7 +27,7 @@ positions as a closed polygon and says which obstacles it goes round.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -182,21 +182,24 @@ def representative_cycles(distances, result: PersistenceResult, bars=None, *, th
     return cycles
 
 
-def region_cycles(region, *, position: float = DEFAULT_POSITION) -> list[Cycle]:
+def region_cycles(region, result: PersistenceResult | None = None, *,
+                  position: float = DEFAULT_POSITION) -> list[Cycle]:
     """Cycles of the significant H1 bars of one mapped region (one call for map.json).
 
-    ``region`` is a :class:`swarmtopo.pipeline.RegionMap`: its landmark distances are
-    re-run through ripser.py for cocycles (the adapter makes its diagram identical to
-    the region's), the bars longer than ``region.thresholds[1]`` are the ones the
+    ``region`` is a :class:`swarmtopo.pipeline.RegionMap`; ``result`` its persistence
+    with cocycles (``rips_persistence(region.landmarks.distances, cocycles=True)``),
+    computed here when not given (the adapter makes its diagram identical to the
+    region's).  The bars longer than ``region.thresholds[1]`` are the ones the
     classifier counts, and each loop carries its landmarks' log event indices.
     """
     if 1 not in region.thresholds:
         return []
     distances = region.landmarks.distances
-    result = rips_persistence(distances, maxdim=1, cocycles=True)
+    if result is None:
+        result = rips_persistence(distances, maxdim=1, cocycles=True)
     cycles = representative_cycles(distances, result, threshold=region.thresholds[1], position=position)
     events = np.asarray(region.landmark_events)
-    return [Cycle(c.landmarks, c.bar, c.bar_index, c.scale, c.length, events[c.landmarks]) for c in cycles]
+    return [replace(c, events=events[c.landmarks]) for c in cycles]
 
 
 # -- ground truth ------------------------------------------------------------------------

@@ -51,6 +51,7 @@ import pyarrow.csv as pcsv
 import pyarrow.parquet as pq
 
 from .errors import InputError, SwarmtopoError
+from .io import _PLAIN_INTEGER, _first_uncastable
 from .log import EncounterLog
 
 FORMATS: tuple[str, ...] = ("csv", "parquet", "sociopatterns", "one")
@@ -60,7 +61,6 @@ SOCIOPATTERNS_WINDOW = 20.0
 _BLOCK = 1 << 22  # bytes per block of a streamed file
 _EXAMPLES = 5  # messages of skipped lines kept in the report
 _NUMBER = r"^[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?$"
-_PLAIN_INTEGER = r"^-?(0|[1-9][0-9]*)$"
 
 
 @dataclass(frozen=True)
@@ -172,7 +172,7 @@ def read_one(path, *, skip_bad: bool = False) -> tuple[EncounterLog, IngestRepor
         has_kind = n >= 2
         kind = _field(fields, 1, has_kind)
         conn = has_kind & _flag(pc.equal(kind, "CONN"))
-        other = ~conn & (n >= 2) & _is_number(_field(fields, 0, has_kind))
+        other = ~conn & has_kind & _is_number(_field(fields, 0, has_kind))
         rows.counts["other_events"] += int(other.sum())
         ok = _field_count_ok(np.where(other, 5, n), (5,), line, rows, "time CONN a b up|down") & ~other
         t_col, a, b, state = (_field(fields, k, ok) for k in (0, 2, 3, 4))
@@ -267,7 +267,7 @@ def _build(t, a, b, line, rows: "_Rows", fmt: str, meta_extra: dict) -> Encounte
         report = rows.report(fmt)
         raise InputError(f"no encounters in the trace ({report.lines} lines read, {report.skipped} skipped as "
                          f"malformed, {report.counts.get('blank_lines', 0)} blank)", file=rows.file)
-    as_int = len(a) and all(pc.all(pc.match_substring_regex(c, _PLAIN_INTEGER)).as_py() for c in (a, b))
+    as_int = all(pc.all(pc.match_substring_regex(c, _PLAIN_INTEGER)).as_py() for c in (a, b))
     if as_int:
         try:
             a, b = (pc.cast(c, pa.int64()).to_numpy(zero_copy_only=False) for c in (a, b))
@@ -508,19 +508,12 @@ def _not_utf8(col: pa.Array) -> np.ndarray:
     bad = np.zeros(len(col), bool)
     while True:
         idx = np.flatnonzero(~bad)
+        rest = col.take(pa.array(idx))
         try:
-            pc.cast(col.take(pa.array(idx)), pa.large_string())
+            pc.cast(rest, pa.large_string())
             return bad
         except pa.ArrowInvalid:
-            lo, hi = 0, len(idx)  # the first bad value is among idx[lo:hi]
-            while hi - lo > 1:
-                mid = (lo + hi) // 2
-                try:
-                    pc.cast(col.take(pa.array(idx[lo:mid])), pa.large_string())
-                    lo = mid
-                except pa.ArrowInvalid:
-                    hi = mid
-            bad[idx[lo]] = True
+            bad[idx[_first_uncastable(rest, pa.large_string())]] = True
 
 
 # -- vectorised checks ------------------------------------------------------------------------
@@ -531,12 +524,12 @@ def _trim(col) -> pa.Array:
 
 
 def _blank_row(cols: dict[str, pa.Array]) -> np.ndarray:
+    """Rows whose every column is empty text (a non-text column is never blank)."""
     blank = np.ones(len(cols["a"]), bool)
     for col in cols.values():
-        if pa.types.is_string(col.type):
-            blank &= pc.equal(pc.utf8_length(col), 0).to_numpy(zero_copy_only=False)
-        else:
-            blank &= False
+        if not pa.types.is_string(col.type):
+            return np.zeros(len(blank), bool)
+        blank &= pc.equal(pc.utf8_length(col), 0).to_numpy(zero_copy_only=False)
     return blank
 
 

@@ -195,16 +195,10 @@ def read_truth(directory) -> dict[str, np.ndarray] | None:
     Keys ``t, a, b, xa, ya, xb, yb`` (float64 times and positions, IDs as in the log)
     plus any extra columns of the file.
     """
-    directory = _log_dir(directory)
-    path = _find_table(directory, "truth")
-    if path is None:
+    found = _read_ground_truth(directory, "truth", TRUTH_COLUMNS, ("a", "b"), ("xa", "ya", "xb", "yb"))
+    if found is None:
         return None
-    table = _read_table(path, TRUTH_COLUMNS, keep_all=True)
-    declared_text = _declares_text_ids(_read_meta(directory / "meta.json"))
-    a, b = _id_arrays([(table["a"], path, "a"), (table["b"], path, "b")], declared_text=declared_text)
-    out = {"t": _number_column(table["t"], path, "t", "time"), "a": _id_numpy(a), "b": _id_numpy(b)}
-    for col in ("xa", "ya", "xb", "yb"):
-        out[col] = _number_column(table[col], path, col, "position")
+    _, table, out = found
     out.update(_extra_columns(table, out))
     return out
 
@@ -215,20 +209,31 @@ def read_trajectories(directory) -> dict[str, np.ndarray] | None:
     Keys ``t, x, y`` (float64), ``agent`` (IDs as in the log), ``state`` (int8 codes
     into STATES) when the file has it, plus any extra columns.
     """
-    directory = _log_dir(directory)
-    path = _find_table(directory, "trajectories")
-    if path is None:
+    found = _read_ground_truth(directory, "trajectories", TRAJECTORY_COLUMNS, ("agent",), ("x", "y"))
+    if found is None:
         return None
-    table = _read_table(path, TRAJECTORY_COLUMNS, keep_all=True)
-    declared_text = _declares_text_ids(_read_meta(directory / "meta.json"))
-    (agent,) = _id_arrays([(table["agent"], path, "agent")], declared_text=declared_text)
-    out = {"t": _number_column(table["t"], path, "t", "time"), "agent": _id_numpy(agent)}
-    for col in ("x", "y"):
-        out[col] = _number_column(table[col], path, col, "position")
+    path, table, out = found
     if "state" in table:
         out["state"] = parse_states(table["state"], str(path))
     out.update(_extra_columns(table, out))
     return out
+
+
+def _read_ground_truth(directory, name: str, columns, id_columns, position_columns):
+    """(path, table, arrays) of the ground-truth table ``name.<fmt>``, or None if absent:
+    ``t`` and the positions as float64, the ID columns as the log reads IDs."""
+    directory = _log_dir(directory)
+    path = _find_table(directory, name)
+    if path is None:
+        return None
+    table = _read_table(path, columns, keep_all=True)
+    declared_text = _declares_text_ids(_read_meta(directory / "meta.json"))
+    ids = _id_arrays([(table[col], path, col) for col in id_columns], declared_text=declared_text)
+    out = {"t": _number_column(table["t"], path, "t", "time")}
+    out.update({col: _id_numpy(values) for col, values in zip(id_columns, ids)})
+    for col in position_columns:
+        out[col] = _number_column(table[col], path, col, "position")
+    return path, table, out
 
 
 def strip_ground_truth(src_dir, dst_dir) -> None:

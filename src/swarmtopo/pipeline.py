@@ -281,7 +281,9 @@ def map_encounters(
         timings["landmarks"] += time.perf_counter() - t0
         say("persistence")
         t0 = time.perf_counter()
-        dgm = rips_persistence(land.distances, maxdim=config.maxdim).diagram
+        # with loops asked for, one run that also keeps the cocycles they are found from
+        persistence = rips_persistence(land.distances, maxdim=config.maxdim, cocycles=config.cycles)
+        dgm = persistence.diagram
         timings["persistence"] += time.perf_counter() - t0
         say("embedding")
         t0 = time.perf_counter()
@@ -312,7 +314,7 @@ def map_encounters(
         if config.cycles:
             say("cycles")
             t0 = time.perf_counter()
-            regions[-1].cycles = region_cycles(regions[-1])
+            regions[-1].cycles = region_cycles(regions[-1], persistence)
             timings["cycles"] += time.perf_counter() - t0
 
     betti: dict[int, int | None] = {0: len(regions)}

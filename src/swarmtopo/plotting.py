@@ -241,14 +241,15 @@ def plot_scores_by(values, series: dict, ax=None, *, xlabel: str, ylabel: str, t
     return ax
 
 
-def plot_cycles(arena, loops, ax=None, *, correct=None, title=None):
+def plot_cycles(arena, loops, ax=None, *, points: np.ndarray | None = None, color=None, correct=None, title=None):
     """Representative cycles drawn at the true positions of their events on the arena.
 
     ``loops`` is a list of (k, 2) arrays of true positions in loop order (closed
     here); ``correct`` optionally flags each loop (green if it encircles exactly one
     obstacle, orange otherwise); without it loops take the tab10 colours.
+    ``points`` / ``color``: other events drawn under the loops (as in :func:`plot_arena`).
     """
-    ax = plot_arena(arena, ax, title=title or "representative cycles at true positions")
+    ax = plot_arena(arena, ax, points=points, color=color, title=title or "representative cycles at true positions")
     for k, loop in enumerate(loops):
         loop = np.asarray(loop, dtype=float)
         closed = np.vstack([loop, loop[:1]])

@@ -52,7 +52,7 @@ def _diagram_figure(tmap: TopologicalMap):
 
 def _cloud_figure(tmap: TopologicalMap, log: EncounterLog, truth, arena):
     from .cycles import event_positions
-    from .plotting import new_figure, plot_arena, plot_cycles, plot_point_cloud, position_colors
+    from .plotting import new_figure, plot_cycles, plot_point_cloud, position_colors
 
     with_truth = truth is not None
     rows = len(tmap.regions)
@@ -69,16 +69,13 @@ def _cloud_figure(tmap: TopologicalMap, log: EncounterLog, truth, arena):
                          title=f"landmarks in encounter space (stress {region.embedding.stress:.2f})")
         if not with_truth:
             continue
-        xy = np.column_stack([(truth["xa"][events] + truth["xb"][events]) / 2,
-                              (truth["ya"][events] + truth["yb"][events]) / 2])
+        xy = event_positions(truth, events)
         bounds = arena.bounds if arena is not None else (*xy.min(axis=0), *xy.max(axis=0))
         colors = position_colors(xy, bounds)
         ax = fig.add_subplot(rows, cols, r * cols + 2, projection="3d" if dim == 3 else None)
         plot_point_cloud(coords, colors, ax, title="coloured by true position")
         if arena is not None:
-            ax = plot_arena(arena, fig.add_subplot(rows, cols, r * cols + 3), points=xy, color=colors,
-                            title="landmark events at true positions" + (", holes' loops" if region.cycles else ""))
-            if region.cycles:
-                plot_cycles(arena, [event_positions(truth, c.events) for c in region.cycles], ax=ax,
-                            title=ax.get_title())
+            plot_cycles(arena, [event_positions(truth, c.events) for c in region.cycles],
+                        fig.add_subplot(rows, cols, r * cols + 3), points=xy, color=colors,
+                        title="landmark events at true positions" + (", holes' loops" if region.cycles else ""))
     return fig

@@ -143,7 +143,9 @@ def script_json(obj) -> str:
     ``json.loads`` (and ``JSON.parse``) give back exactly ``obj``.
     """
     text = json.dumps(obj, allow_nan=False, separators=(",", ":"), ensure_ascii=False)
-    return "".join(_SCRIPT_ESCAPES.get(c, c) for c in text)
+    for char, escape in _SCRIPT_ESCAPES.items():  # no escape contains a char escaped here: order is free
+        text = text.replace(char, escape)
+    return text
 
 
 # -- sections ------------------------------------------------------------------------------
@@ -231,13 +233,14 @@ def _arena_section(tmap: TopologicalMap, truth: dict, arena, figures: dict) -> s
     parts = []
     for k, region in enumerate(tmap.regions):
         key = f"plot-arena-{k}"
-        figures[key] = _arena_figure(region, truth, arena)
+        loops = [event_positions(truth, cycle.events) for cycle in region.cycles]
+        figures[key] = _arena_figure(region, loops, truth, arena)
         rows = []
-        for c, cycle in enumerate(region.cycles):
+        for c, (cycle, loop) in enumerate(zip(region.cycles, loops)):
             b, d = cycle.bar
             where = ""
             if arena is not None:
-                found = encircled_obstacles(event_positions(truth, cycle.events), arena)
+                found = encircled_obstacles(loop, arena)
                 where = ("encircles no obstacle" if not found else
                          "encircles obstacle" + ("s " if len(found) > 1 else " ") + ", ".join(map(str, found)))
             death = f"{d:.4g}" if np.isfinite(d) else "&infin;"
@@ -431,9 +434,7 @@ def _cloud_figure(region, log: EncounterLog, truth, arena) -> dict:
     titles = [{"text": "coloured by event time", "showarrow": False, "xref": "paper", "yref": "paper",
                "x": 0.22 if truth is not None else 0.5, "y": 1.0, "font": {"size": 14}}]
     if truth is not None:
-        xy = event_positions(truth, events)
-        bounds = arena.bounds if arena is not None else (*xy.min(axis=0), *xy.max(axis=0))
-        data.append(points(_rgb(position_colors(xy, bounds)), "scene2"))
+        data.append(points(_true_position_colors(event_positions(truth, events), arena), "scene2"))
         if dim == 3:
             layout["scene2"] = {"domain": {"x": [0.52, 1]}, "xaxis": axis, "yaxis": axis, "zaxis": axis,
                                 "aspectmode": "data"}
@@ -463,7 +464,8 @@ def _arena_traces(arena) -> list[dict]:
 
 
 def _plane_layout(arena, height: int) -> dict:
-    layout = {"xaxis": {"title": {"text": "x (mm)"}, "constrain": "domain"}, "yaxis": {"title": {"text": "y (mm)"}, "scaleanchor": "x"},
+    layout = {"xaxis": {"title": {"text": "x (mm)"}, "constrain": "domain"},
+              "yaxis": {"title": {"text": "y (mm)"}, "scaleanchor": "x"},
               "margin": {"t": 20, "l": 60, "r": 20, "b": 50}, "height": height,
               "legend": {"orientation": "h", "y": -0.12}}
     if arena is not None:
@@ -474,16 +476,20 @@ def _plane_layout(arena, height: int) -> dict:
     return layout
 
 
-def _arena_figure(region, truth: dict, arena) -> dict:
-    events = np.asarray(region.landmark_events)
-    xy = event_positions(truth, events)
+def _true_position_colors(xy: np.ndarray, arena) -> list[str]:
+    """Colours of true positions over the arena's bounds (the points' own without an arena)."""
     bounds = arena.bounds if arena is not None else (*xy.min(axis=0), *xy.max(axis=0))
+    return _rgb(position_colors(xy, bounds))
+
+
+def _arena_figure(region, loops: list[np.ndarray], truth: dict, arena) -> dict:
+    """Landmark events at their true positions and each cycle's ``loops`` entry (true positions)."""
+    xy = event_positions(truth, np.asarray(region.landmark_events))
     data = _arena_traces(arena) if arena is not None else []
     data.append({"type": "scatter", "mode": "markers", "x": _floats(xy[:, 0], 2), "y": _floats(xy[:, 1], 2),
-                 "marker": {"color": _rgb(position_colors(xy, bounds)), "size": 5}, "name": "landmark events",
+                 "marker": {"color": _true_position_colors(xy, arena), "size": 5}, "name": "landmark events",
                  "hovertemplate": "landmark event at (%{x:.0f}, %{y:.0f}) mm<extra></extra>"})
-    for c, cycle in enumerate(region.cycles):
-        loop = event_positions(truth, cycle.events)
+    for c, (cycle, loop) in enumerate(zip(region.cycles, loops)):
         closed = np.vstack([loop, loop[:1]])
         color = _LOOP_COLORS[c % len(_LOOP_COLORS)]
         data.append({"type": "scatter", "mode": "lines+markers", "x": _floats(closed[:, 0], 2),
@@ -504,7 +510,8 @@ def _animation_figure(trajectories: dict, arena) -> tuple[dict, int, int]:
     at MAX_ANIMATION_FRAMES times.  Agents absent at a time are left out of that frame."""
     t = np.asarray(trajectories["t"], dtype=float)
     agent = np.asarray(trajectories["agent"])
-    times = np.unique(t)[_evenly(len(np.unique(t)), MAX_ANIMATION_FRAMES)]
+    times = np.unique(t)
+    times = times[_evenly(len(times), MAX_ANIMATION_FRAMES)]
     agents = np.unique(agent)
     agents = agents[_evenly(len(agents), MAX_ANIMATION_AGENTS)]
     keep = np.isin(t, times) & np.isin(agent, agents)

@@ -21,12 +21,11 @@ from typing import Any, Callable
 import numpy as np
 
 from .._validate import positive_int
-from ..arena import random_arena
 from ..classify import detection_scores, paper_classifier
 from ..persistence import Diagram
 from .grid import expand_grid
 from .store import read_jobs
-from .sweep import run_sweep
+from .sweep import build_arena, run_sweep
 from .training import Examples, examples_from_rows, fit_and_select
 
 SCALES = (0.75, 0.9, 1.0, 1.1, 1.25)
@@ -53,35 +52,36 @@ def clust_sweeps(runs: int = RUNS) -> dict[str, Any]:
 def reproduce_clust(out: Path, *, runs: int | None = None, progress: Callable[[int, int, int], None] | None = None,
                     store: Path | None = None, workers: int | None = None, scheduler: str | None = None):
     """Run the sweeps, fit, test, and write ``clust.csv`` and the figures into ``out``."""
-    from .reproduce import write_reproduction
+    from .reproduce import output_folder, write_reproduction
     from ..plotting import plot_arena, plot_diagram, new_figure, plot_ratio_density, plot_scores_by
 
     runs = RUNS if runs is None else positive_int("runs", runs)
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_folder(out)
     store = Path(store) if store else out / "clust.duckdb"
     sweeps = clust_sweeps(runs)
     summary = run_sweep([job for s in sweeps.values() for job in s.jobs], store,
                         workers=workers, scheduler=scheduler, progress=progress)
-    rows = {name: read_jobs(store, sweep=s.name) for name, s in sweeps.items()}
+    by_key = {row["key"]: row for row in read_jobs(store)}
+    rows = {name: [by_key[key] for key in sorted(job.key for job in s.jobs)] for name, s in sweeps.items()}
     train = examples_from_rows(rows["train"])
 
     selection = fit_and_select(train, _test_pool(rows), {"name": "clust", "runs": runs})
     models = {**selection.fits, "paper": paper_classifier()}
 
+    test_sets = _test_sets(rows)
     table: list[dict[str, Any]] = []
     for name, model in models.items():
         th = model.theta_[1]
-        train_f = model.train_error_.get(1)
-        for label, subset in _test_sets(rows):
-            scores = detection_scores(model.predict(subset.diagrams), subset.truth)
-            row = {"classifier": name, "q": th.q, "delta": th.delta, "tau": th.tau,
-                   "train_F": train_f if train_f is not None else _train_error(model, train),
+        train_f = detection_scores(model.predict(train.diagrams), train.truth).mean_absolute_error
+        for label, subset in test_sets:
+            estimates = model.predict(subset.diagrams)
+            scores = detection_scores(estimates, subset.truth)
+            row = {"classifier": name, "q": th.q, "delta": th.delta, "tau": th.tau, "train_F": train_f,
                    "test_set": label, "maps": scores.maps, "F": scores.mean_absolute_error,
                    "SE": scores.sensitivity, "false_hole_rate": scores.false_hole_rate, "exact": scores.exact,
                    "excluded": sum(subset.excluded.values())}
             if label == "holes=3":
-                row["third_hole_missed"] = float(np.mean(model.predict(subset.diagrams) < 3))
+                row["third_hole_missed"] = float(np.mean(estimates < 3))
             table.append(row)
 
     winner = selection.classifier
@@ -89,7 +89,7 @@ def reproduce_clust(out: Path, *, runs: int | None = None, progress: Callable[[i
     axes = fig.subplots(1, 5)
     example = next(r for r in rows["train"] if r["error"] is None)
     job = next(j for j in sweeps["train"].jobs if j.key == example["key"])
-    plot_arena(random_arena(2, rng=job.stream_seeds()["arena"], shapes=("square",)), ax=axes[0],
+    plot_arena(build_arena(job.config["arena"], job.stream_seeds()["arena"]), ax=axes[0],
                title="(a) a training environment")
     dgm = Diagram.from_json(example["diagrams"][0]["diagram"])
     plot_diagram(dgm, ax=axes[1], thresholds=winner.thresholds(dgm), title="(b) its diagram")
@@ -133,7 +133,3 @@ def _test_pool(rows) -> Examples:
     """Every test map once (the shared 2-hole, scale-1 set counted once)."""
     unique = {r["key"]: r for key in ("scale", "holes") for r in rows[key]}
     return examples_from_rows(list(unique.values()))
-
-
-def _train_error(model, train: Examples) -> float:
-    return detection_scores(model.predict(train.diagrams), train.truth).mean_absolute_error

@@ -63,6 +63,7 @@ import json
 import math
 import tomllib
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import Any, Callable
 
@@ -211,12 +212,12 @@ class Job:
     @property
     def key(self) -> str:
         """Hex SHA-256 of the canonical JSON of (config, replicate, salt): the job's identity."""
-        return self._digest().hex()
+        return self._digest.hex()
 
     @property
     def seed(self) -> int:
         """64-bit seed: the first 8 bytes of the key's hash, as an unsigned integer."""
-        return int.from_bytes(self._digest()[:8], "big")
+        return int.from_bytes(self._digest[:8], "big")
 
     def stream_seeds(self) -> dict[str, int]:
         """Independent seeds of the job's streams (``STREAMS``), spawned from
@@ -229,7 +230,9 @@ class Job:
         ``"map.classifier"``); None if the job has none."""
         return dict(self.files).get(key)
 
+    @cached_property
     def _digest(self) -> bytes:
+        """SHA-256 of the canonical JSON of (config, replicate, salt), computed once per job."""
         identity = {"config": json.loads(self.config_json), "replicate": self.replicate, "salt": self.salt}
         return hashlib.sha256(canonical_json(identity).encode()).digest()
 

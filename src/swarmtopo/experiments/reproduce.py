@@ -47,6 +47,7 @@ from scipy.stats import spearmanr
 from .._validate import positive_int
 from ..arena import Arena, annulus_arena, default_arena
 from ..classify import load_classifier
+from ..cycles import event_positions
 from ..embed import mds
 from ..errors import InputError, SwarmtopoError
 from ..graph import build_graph
@@ -260,7 +261,7 @@ def metric_diagnostics(distances: np.ndarray, t: np.ndarray, xy: np.ndarray) -> 
 # -- experiments ------------------------------------------------------------------------
 def reproduce_enc(out: Path, *, runs: int | None = None, progress: Progress | None = None) -> Reproduction:
     """Fig. "enc": the encounter cloud of agents on a thin ring is a cylinder over it."""
-    name, out = "enc", _folder(out)
+    name, out = "enc", output_folder(out)
     runs = _runs(name, runs)
     arena, agents = ring_arena(), ring_agents()
     centre = _centre(arena)
@@ -273,13 +274,14 @@ def reproduce_enc(out: Path, *, runs: int | None = None, progress: Progress | No
         row = {"run": i, "seed": seed, **_map_row(tmap, error)}
         if tmap is not None:
             region = tmap.regions[0]
-            xy = _event_positions(sim.truth, region.landmark_events)
+            xy = event_positions(sim.truth, region.landmark_events)
             checks = cylinder_checks(region.landmarks.distances, sim.log.t[region.landmark_events], xy, centre)
-            concordance = ring_concordance(region.embedding.coords, ring_angle(xy, centre))
+            angle = ring_angle(xy, centre)
+            concordance = ring_concordance(region.embedding.coords, angle)
             row.update(rho_time=checks.rho_time, rho_angle=checks.rho_angle, angle_concordance=concordance,
                        mds_stress=region.embedding.stress)
             if picture is None:
-                picture = (sim, tmap, xy, ring_angle(xy, centre), concordance, seed)
+                picture = (sim, tmap, xy, angle, concordance, seed)
         rows.append(row)
         tick(failed=tmap is None)
 
@@ -301,7 +303,7 @@ def reproduce_enc(out: Path, *, runs: int | None = None, progress: Progress | No
 
 def reproduce_encmds(out: Path, *, runs: int | None = None, progress: Progress | None = None) -> Reproduction:
     """Fig. "encmds": one-hole square, 200 agents, 20 s, plain encounter metric."""
-    name, out = "encmds", _folder(out)
+    name, out = "encmds", output_folder(out)
     runs = _runs(name, runs)
     arena = default_arena()
     tick = _Ticker(runs, progress)
@@ -337,7 +339,7 @@ and the contracted metric of the hybrid network (5 % static agents), which is wh
 
 def reproduce_encimpr(out: Path, *, runs: int | None = None, progress: Progress | None = None) -> Reproduction:
     """Fig. "encImpr": plain vs contracted vs hybrid metric over 200 s (and the first 20 s)."""
-    name, out = "encimpr", _folder(out)
+    name, out = "encimpr", output_folder(out)
     runs = _runs(name, runs)
     arena = default_arena()
     durations = (DURATION, LONG_DURATION)
@@ -360,7 +362,7 @@ def reproduce_encimpr(out: Path, *, runs: int | None = None, progress: Progress 
                     region = tmap.regions[0]
                     events = region.landmark_events
                     row.update(metric_diagnostics(region.landmarks.distances, sim.log.t[events],
-                                                  _event_positions(sim.truth, events)))
+                                                  event_positions(sim.truth, events)))
                     if draw:
                         pictures[metric] = (sim, tmap)
                 rows.append(row)
@@ -405,7 +407,7 @@ LAND2_METHODS: dict[str, Callable] = {
 def reproduce_land2(out: Path, *, runs: int | None = None, progress: Progress | None = None) -> Reproduction:
     """Fig. "land2": three subsamplers on one contracted encounter cloud, SNR over ``runs``
     independent subsamplings (landmark seeds :func:`run_seed` ("land2", r))."""
-    name, out = "land2", _folder(out)
+    name, out = "land2", output_folder(out)
     runs = _runs(name, runs)
     cloud_seed = run_seed("encmds", 0)
     sim = simulate(default_arena(), AGENTS, DURATION, rng=cloud_seed)
@@ -499,7 +501,8 @@ class _Ticker:
             self.progress(self.done, self.total, self.failed)
 
 
-def _folder(out) -> Path:
+def output_folder(out) -> Path:
+    """``out`` as a Path, created (one-line SwarmtopoError if it cannot be)."""
     out = Path(out)
     try:
         out.mkdir(parents=True, exist_ok=True)
@@ -531,12 +534,6 @@ def _map_row(tmap: TopologicalMap | None, error: str) -> dict[str, Any]:
             "landmarks": sum(len(r.landmarks.nodes) for r in tmap.regions),
             "beta_1": tmap.betti[1], "confidence_1": tmap.confidence.get(1),
             **h1_bars(tmap.diagram), "error": ""}
-
-
-def _event_positions(truth: dict[str, np.ndarray], events: np.ndarray) -> np.ndarray:
-    """True position of each event: the midpoint of its two agents, (n, 2) mm."""
-    return np.column_stack([(truth["xa"][events] + truth["xb"][events]) / 2,
-                            (truth["ya"][events] + truth["yb"][events]) / 2])
 
 
 def _centre(arena: Arena) -> tuple[float, float]:
@@ -650,7 +647,7 @@ def _encmds_figure(path: Path, arena: Arena, sim, tmap: TopologicalMap) -> Path:
     events = region.landmark_events
     times = sim.log.t[events]
     fig = new_figure(16, 5)
-    plot_arena(arena, fig.add_subplot(1, 3, 1), points=_event_positions(sim.truth, events), color=times,
+    plot_arena(arena, fig.add_subplot(1, 3, 1), points=event_positions(sim.truth, events), color=times,
                title="(a) one-hole arena, landmark events by time")
     plot_point_cloud(region.embedding.coords, times, fig.add_subplot(1, 3, 2, projection="3d"),
                      label="event time (s)", title=f"(b) encounter cloud over {DURATION:g} s (MDS)")

@@ -119,11 +119,12 @@ def run_job(job: Job) -> dict[str, Any]:
             confidence_betti0=tmap.confidence.get(0), confidence_betti1=tmap.confidence.get(1),
             snr_h1=ratio.ratio, noise_power_h1=ratio.noise_power,
             lengths_h1=[float(x) for x in tmap.diagram.lengths(1)],
-            diagrams=[{"events": r.n_events, "agents": r.n_agents, "landmarks": int(len(r.landmarks.nodes)),
+            diagrams=[{"events": r.n_events, "agents": r.n_agents, "landmarks": len(r.landmarks.nodes),
                        "diagram": r.diagram.to_json()} for r in tmap.regions],
-            n_regions=len(tmap.regions), n_landmarks=sum(int(len(r.landmarks.nodes)) for r in tmap.regions),
+            n_regions=len(tmap.regions),
             **{column: tmap.timings[stage] for stage, column in _STAGE_COLUMNS.items()},
         )
+        row["n_landmarks"] = sum(region["landmarks"] for region in row["diagrams"])
         row["versions"] = {**row["versions"], "classifier": tmap.classifier["classifier"],
                            "theta": tmap.classifier["theta"]}
     row["worker"] = f"{socket.gethostname()}:{os.getpid()}"
