@@ -21,6 +21,7 @@ import logging
 import os
 import signal
 import socket
+import threading
 import time
 from collections import Counter
 from contextlib import contextmanager
@@ -42,6 +43,8 @@ from .store import JOB_COLUMNS, ResultStore
 WORKER_WAIT = 120.0
 """Seconds ``run_sweep`` waits for a first worker on an existing scheduler."""
 CONNECT_TIMEOUT = 10.0
+POLL_SECONDS = 0.05
+"""How often ``run_sweep`` looks for finished jobs and for Ctrl-C while it waits."""
 """Seconds ``run_sweep`` tries to reach an existing scheduler."""
 _STAGE_COLUMNS = {"graph": "t_graph", "landmarks": "t_landmarks", "persistence": "t_persistence",
                   "classify": "t_classify"}
@@ -227,20 +230,49 @@ def run_sweep(
             futures = dict(zip((job.key for job in pending),
                                client.map(run_job, pending, key=[f"swarmtopo-job-{job.key}" for job in pending])))
             say(0, len(pending), 0)
+            finished = as_completed(list(futures.values()))
             try:
-                for future in as_completed(list(futures.values())):
-                    row = future.result()
-                    store.insert(row)
-                    futures.pop(row["key"]).release()
-                    run += 1
-                    if row["error"] is not None:
-                        errors[row["error"]] += 1
-                    say(run, len(pending), sum(errors.values()))
+                with _deferred_interrupt() as interrupted:
+                    while not finished.is_empty():
+                        if interrupted():
+                            raise KeyboardInterrupt
+                        batch = finished.next_batch(block=False)
+                        if not batch:
+                            time.sleep(POLL_SECONDS)
+                        for future in batch:
+                            row = future.result()
+                            store.insert(row)
+                            futures.pop(row["key"]).release()
+                            run += 1
+                            if row["error"] is not None:
+                                errors[row["error"]] += 1
+                            say(run, len(pending), sum(errors.values()))
             finally:
                 client.cancel(list(futures.values()))
         return SweepSummary(total=len(unique), skipped=len(unique) - len(pending), run=run,
                             failed=sum(errors.values()), seconds=time.perf_counter() - start,
                             workers=n_workers, errors=dict(errors))
+
+
+@contextmanager
+def _deferred_interrupt():
+    """Turn SIGINT into a flag the caller polls (yields ``interrupted() -> bool``).
+
+    A KeyboardInterrupt raised inside one of distributed's blocking calls makes its
+    event loop log a traceback (a NameError in ``distributed.utils.sync``'s cancel
+    callback, seen with distributed 2026.8); raised by the caller between calls, it
+    leaves distributed in a clean state.  Outside the main thread signals cannot be
+    caught, so nothing changes there.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield lambda: False
+        return
+    flag = threading.Event()
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: flag.set())
+    try:
+        yield flag.is_set
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 @contextmanager
