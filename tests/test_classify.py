@@ -223,7 +223,7 @@ def test_malformed_classifier_files_name_the_file(tmp_path):
 def test_shipped_presets():
     paper = load_classifier("paper")
     assert paper.theta_[1] == Theta(*PAPER_THETA[1])
-    default = load_classifier("default")
-    assert default.provenance_["name"] == "default"
-    assert "script" in default.provenance_ and "seeds" in default.provenance_
-    assert default.calibration_["maps"] > 0
+    trained = load_classifier("paper-form")
+    assert isinstance(trained, BettiClassifier) and trained.provenance_["name"] == "paper-form"
+    assert "script" in trained.provenance_ and "seeds" in trained.provenance_
+    assert trained.calibration_["maps"] > 0

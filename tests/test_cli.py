@@ -77,12 +77,17 @@ def test_map_never_reads_ground_truth(tmp_path, simulated):
     # keep only what a real deployment's meta.json may declare: no r_d, speeds, dt, seed
     meta = json.loads((stripped / "meta.json").read_text())
     (stripped / "meta.json").write_text(json.dumps({k: meta[k] for k in ("agent_count", "static", "units")}))
+    # r_d and v_c set the default per-hop cost, so the comparison fixes it
     for src, out in ((simulated[0], tmp_path / "full"), (stripped, tmp_path / "bare")):
-        assert run("map", src, "--out", out, "--quiet").returncode == 0
+        assert run("map", src, "--out", out, "--quiet", "--hop-cost", "2").returncode == 0
         doc = json.loads((out / "map.json").read_text())
         doc.pop("timings")
         docs.append(doc)
     assert docs[0] == docs[1]
+    # without them the cost comes from the data, and map.json says so
+    assert run("map", stripped, "--out", tmp_path / "auto", "--quiet").returncode == 0
+    params = json.loads((tmp_path / "auto" / "map.json").read_text())["params"]
+    assert params["hop_cost"] is None and "mean time between an agent's encounters" in params["hop_cost_source"]
 
 
 def test_demo_prints_recovered_and_true_betti_numbers(tmp_path):
@@ -173,3 +178,25 @@ def test_quiet_verbose_and_pipes(tmp_path, simulated):
     assert verbose.returncode == 0 and verbose.stdout == normal.stdout.replace(str(tmp_path / "n"), str(tmp_path / "v"))
     assert "stages: graph" in verbose.stderr and "region 0:" in verbose.stderr
     assert_one_line_error(run("map", simulated[0], "-q", "-v"), "--quiet and --verbose exclude each other", code=2)
+
+
+def test_map_paper_and_pipeline_options(simulated, tmp_path):
+    paper = run("map", simulated[0], "--out", tmp_path / "p", "--paper")
+    assert paper.returncode == 0, paper.stderr
+    doc = json.loads((tmp_path / "p" / "map.json").read_text())
+    assert doc["params"]["hop_cost"] == 0.0 and doc["params"]["window_length"] is None
+    assert doc["classifier"]["classifier"] == "paper" and len(doc["regions"][0]["windows"]) == 1
+    default = run("map", simulated[0], "--out", tmp_path / "d", "--hop-cost", "1.5", "--window-length", "8")
+    assert default.returncode == 0, default.stderr
+    doc = json.loads((tmp_path / "d" / "map.json").read_text())
+    assert doc["params"]["hop_cost_used"] == 1.5 and doc["params"]["window_length"] == 8.0
+    assert len(doc["regions"][0]["windows"]) > 1
+    assert_one_line_error(run("map", simulated[0], "--paper", "--hop-cost", "1"), "--paper fixes --hop-cost", code=2)
+    assert_one_line_error(run("map", simulated[0], "--window-length", "-3"), "positive number", code=2)
+    assert_one_line_error(run("map", simulated[0], "--hop-cost", "-1"), "--hop-cost", code=2)
+
+
+def test_bench_and_plan_help_show_examples():
+    for args in (("bench", "accuracy", "--help"), ("plan", "--help")):
+        proc = run(*args)
+        assert proc.returncode == 0 and "Example" in proc.stdout

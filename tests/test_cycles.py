@@ -159,8 +159,8 @@ def test_scores_and_wilson_interval():
 
 
 def test_simulated_one_hole_cycle_encircles_the_hole():
-    # Seed 0: the shipped classifier finds beta_1 = 1 on this log (checked below).
-    sim = simulate(default_arena(), 200, 20.0, rng=0, truth=True)
+    # The demo's log (seed 0, 200 agents x 30 s): the default finds beta_1 = 1 (checked below).
+    sim = simulate(default_arena(), 200, 30.0, rng=0, truth=True)
     tmap = map_encounters(sim.log, MapConfig(seed=0, embed_dim=0))
     assert tmap.betti[1] == 1
     (region,) = tmap.regions

@@ -388,3 +388,59 @@ def test_million_events_build_in_linear_memory():
         tracemalloc.stop()
         assert graph.n_events == 10**6
         assert peak < 500 * 2**20, f"{metric}: peak {peak / 2**20:.0f} MiB"
+
+
+# -- per-hop cost ----------------------------------------------------------------------------
+def test_hop_cost_hand_computed_on_the_chain_graph():
+    # Plain metric, h = 1: chain edges agent 0 e0-e3 7, agent 1 e1-e4 7, agent 2 e0-e1 2,
+    # e1-e2 4, e2-e3 3, agent 3 e2-e4 4.  d(e0,e2) = e0-e1-e2 = 6, where the paper's
+    # all-pairs graph plus h would give the direct edge 4 + 1 = 5: the two differ.
+    expected = np.array([
+        [0, 2, 6, 7, 9],
+        [2, 0, 4, 7, 7],
+        [6, 4, 0, 3, 4],
+        [7, 7, 3, 0, 7],
+        [9, 7, 4, 7, 0],
+    ], dtype=float)
+    graph = build_graph(stop_and_static_log(), "plain", hop_cost=1.0)
+    np.testing.assert_array_equal(event_distances(graph), expected)
+
+
+def chain_distances_with_hop_cost(log: EncounterLog, metric: str, h: float) -> np.ndarray:
+    """Literal chain metric with per-hop cost: each agent's events in time order, joined
+    consecutively by the paper's weight (0 inside one stop interval of that agent, read
+    off the status rows as in networkx_distances) plus h."""
+    stops = stops_from_status_rows(log) if metric != "plain" else {}
+    if metric == "hybrid":
+        for agent, time in zip(log.static_agent, log.static_time):
+            stops.setdefault(int(agent), []).append((float(time), INF))
+    stops = {k: merged(v) for k, v in stops.items()}
+    g = nx.Graph()
+    g.add_nodes_from(range(log.n_events))
+    for k in range(log.n_agents):
+        members = [i for i in range(log.n_events) if k in (log.a[i], log.b[i])]
+        for i, j in zip(members, members[1:]):
+            ti, tj = float(log.t[i]), float(log.t[j])
+            still = any(s <= ti <= e and s <= tj <= e for s, e in stops.get(k, []))
+            w = (0.0 if still else tj - ti) + h
+            if not g.has_edge(i, j) or g[i][j]["weight"] > w:
+                g.add_edge(i, j, weight=w)
+    out = np.full((log.n_events, log.n_events), INF)
+    for i, lengths in nx.all_pairs_dijkstra_path_length(g):
+        for j, d in lengths.items():
+            out[i, j] = d
+    return out
+
+
+@settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(log=small_logs(), h=st.sampled_from([0.5, 2.0]), metric=st.sampled_from(METRICS))
+def test_hop_cost_graph_equals_literal_chain(log, h, metric):
+    graph = build_graph(log, metric, hop_cost=h)
+    np.testing.assert_allclose(event_distances(graph), chain_distances_with_hop_cost(log, metric, h),
+                               rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("bad", [-1.0, float("nan"), float("inf"), "two"])
+def test_bad_hop_cost_is_an_input_error(bad):
+    with pytest.raises(InputError, match="hop cost"):
+        build_graph(stop_and_static_log(), "plain", hop_cost=bad)

@@ -86,8 +86,8 @@ def test_grid_is_the_product_of_lists_times_replicates_with_defaults():
         "arena": {"generator": "random", "holes": job.config["arena"]["holes"], "shapes": ["square"],
                   "outer": "square", "scale": 1.0},
         "swarm": {"agents": job.config["swarm"]["agents"], "duration": 20.0, "static_fraction": 0.0},
-        "map": {"metric": "hybrid", "subsample": "maxmin", "landmarks": "auto", "max_landmarks": 1000,
-                "maxdim": 1, "classifier": "default"},
+        "map": {"metric": "hybrid", "hop_cost": "auto", "window_length": 20.0, "window_step": "auto",
+                "subsample": "maxmin", "landmarks": "auto", "max_landmarks": 400, "maxdim": 1, "classifier": "default"},
     }
     # max_landmarks only caps "auto": a fixed L drops it
     assert "max_landmarks" not in next(j for j in sweep.jobs if j.config["map"]["landmarks"] == 150).config["map"]
@@ -160,6 +160,9 @@ def test_keys_are_the_same_in_another_process():
     ("[map]\nmaxdim = 3", ["[map] maxdim = 3", "1..2"]),
     ("[map]\nmetric = 'hybird'", ['[map] metric = "hybird"', "plain, contracted, hybrid"]),
     ("[map]\nlandmarks = 100\nmax_landmarks = 500", ["[map] max_landmarks", "landmarks is a number"]),
+    ("[map]\nhop_cost = -2", ["[map] hop_cost = -2", '>= 0 or "auto"']),
+    ("[map]\nwindow_length = 'all'", ['[map] window_length = "all"', '> 0 or "none"']),
+    ("[map]\nwindow_length = 'none'\nwindow_step = 5", ["[map] window_step", 'window_length is "none"']),
     ("[map]\nclassifier = 'nope.json'", ['[map] classifier = "nope.json"', "cannot read"]),
     ("[arena]\nholes = []", ["[arena] holes = []", "empty list"]),
     ("[arena]\nshapes = ['hexagon']", ['[arena] shapes = ["hexagon"]', "square"]),
@@ -188,7 +191,8 @@ def test_cli_bad_config_is_one_line_exit_1(tmp_path):
     proc = run_cli("sweep", path, "--store", tmp_path / "r.duckdb")
     assert proc.returncode == 1 and "Traceback" not in proc.stderr
     assert proc.stderr.strip().splitlines() == [f"error: {path}: [map] metrc: unknown key; expected one of "
-                                                "metric, subsample, landmarks, max_landmarks, maxdim, classifier"]
+                                                "metric, hop_cost, window_length, window_step, subsample, landmarks, "
+                                                "max_landmarks, maxdim, classifier"]
     assert not (tmp_path / "r.duckdb").exists()
 
 

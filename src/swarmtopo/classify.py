@@ -61,7 +61,7 @@ MAX_MARGIN = 5.0
 """Cap of the log-ratio margin (a bar e^5 ~ 150 times off the threshold is as sure as it gets)."""
 PAPER_THETA = {1: (0.5, 0.7, 3.7)}
 """The paper's published Theta*_1 = (q_1, Delta_1, tau_1), F = 0.03 on its training set."""
-PRESETS = ("default", "paper")
+PRESETS = ("default", "paper", "paper-form")
 """Classifiers shipped with the package (``load_classifier(name)``)."""
 
 Q_GRID = tuple(np.round(np.arange(0.05, 0.951, 0.05), 2))
@@ -232,8 +232,9 @@ class BettiClassifier(BaseEstimator):
         out = out.reshape(len(X), len(self.theta_))
         return out[:, 0] if len(self.theta_) == 1 else out
 
-    def betti(self, diagram: Diagram) -> dict[int, int]:
-        """beta_hat_n of one diagram, for n in dims up to the diagram's maxdim."""
+    def betti(self, diagram: Diagram, cover_radius: float | None = None) -> dict[int, int]:
+        """beta_hat_n of one diagram, for n in dims up to the diagram's maxdim
+        (``cover_radius`` is not used: the paper's form reads bar lengths only)."""
         self._check_fitted()
         return {n: betti_function(bar_lengths(diagram, n), th.q, th.delta, th.tau)
                 for n, th in self.theta_.items() if n <= diagram.maxdim}
@@ -243,6 +244,27 @@ class BettiClassifier(BaseEstimator):
         self._check_fitted()
         return {n: th.tau * quantile_scale(bar_lengths(diagram, n), th.q, th.delta)
                 for n, th in self.theta_.items() if n <= diagram.maxdim}
+
+    def margin(self, diagram: Diagram, cover_radius: float | None, n: int) -> float:
+        """The log-ratio margin m of the bar nearest the threshold (:func:`confidence_features`)."""
+        th = self.theta_[n]
+        return confidence_features(bar_lengths(diagram, n), th.q, th.delta, th.tau)[0]
+
+    def counted(self, diagram: Diagram, cover_radius: float | None = None) -> dict[int, np.ndarray]:
+        """Indices of the counted bars of each dimension (longer than the threshold)."""
+        return {n: np.flatnonzero(np.diff(diagram[n], axis=1)[:, 0] > tau)
+                for n, tau in self.thresholds(diagram).items()}
+
+    def length_thresholds(self, diagram: Diagram, cover_radius: float | None = None) -> dict[int, float]:
+        """Same as :meth:`thresholds` (the interface shared with the ratio classifier)."""
+        return self.thresholds(diagram)
+
+    def region_confidence(self, windows) -> dict[int, float | None]:
+        """Confidence of a region mapped in windows: that of its representative window."""
+        from .ratio import vote
+
+        _, rep, _ = vote(self, windows)
+        return self.confidence(windows[rep].diagram)
 
     def confidence(self, diagram: Diagram) -> dict[int, float | None]:
         """P(beta_hat_n is right) from the calibrated (margin, gap) model; None if uncalibrated."""
@@ -392,17 +414,30 @@ def detection_scores(estimated, truth) -> DetectionScores:
 
 
 # -- shipped classifiers ---------------------------------------------------------------
-def load_classifier(name: str | Path) -> BettiClassifier:
-    """A shipped classifier by name (``PRESETS``: "default", trained by
-    ``scripts/train_classifier.py``; "paper", the paper's Theta*) or a JSON file."""
+def load_classifier(name: str | Path):
+    """A shipped classifier by name or a JSON file.
+
+    Presets (``PRESETS``): "default", the :class:`~swarmtopo.ratio.RatioClassifier`
+    tuned on the accuracy benchmark by ``scripts/tune_accuracy.py``; "paper-form", the
+    paper's classifier form trained our way by ``scripts/train_classifier.py``;
+    "paper", the paper's published Theta*.  A file may hold either form (its
+    ``format`` key says which).
+    """
+    from .io import read_json
+    from .ratio import RATIO_FORMAT, RatioClassifier
+
     if str(name) in PRESETS:
-        return BettiClassifier.from_json(json.loads(_preset_text(str(name))),
-                                         source=f"swarmtopo/data/classifier-{name}.json")
-    path = Path(name)
-    if not path.exists():
-        raise InputError(f"no such classifier: expected one of {', '.join(PRESETS)} or a JSON file",
-                         file=str(path), value=str(name))
-    return BettiClassifier.load(path)
+        source = f"swarmtopo/data/classifier-{name}.json"
+        obj = json.loads(_preset_text(str(name)))
+    else:
+        path = Path(name)
+        if not path.exists():
+            raise InputError(f"no such classifier: expected one of {', '.join(PRESETS)} or a JSON file",
+                             file=str(path), value=str(name))
+        source, obj = str(path), read_json(path)
+    if isinstance(obj, dict) and obj.get("format") == RATIO_FORMAT:
+        return RatioClassifier.from_json(obj, source=source)
+    return BettiClassifier.from_json(obj, source=source)
 
 
 @lru_cache(maxsize=None)

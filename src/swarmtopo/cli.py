@@ -28,6 +28,8 @@ app = typer.Typer(
 )
 out = Console()
 err = Console(stderr=True)
+DEMO_AGENTS, DEMO_SECONDS = 200, 30.0
+"""The demo's swarm: the accuracy benchmark's smallest budget."""
 VERBOSE_HELP = "Also report each stage's details and timings on stderr (in pipes too)."
 
 
@@ -167,6 +169,18 @@ def _parse_window(text: Optional[str]):
     return tuple(None if e is None or math.isinf(e) else e for e in ends)
 
 
+def _parse_window_length(text: Optional[str]):
+    if text is None or text == "none":
+        return text
+    try:
+        value = float(text)
+    except ValueError:
+        raise typer.BadParameter(f"{text!r} is not a number of seconds or 'none'") from None
+    if not (math.isfinite(value) and value > 0):
+        raise typer.BadParameter(f"{text!r}: the window length must be a positive number of seconds")
+    return text
+
+
 @app.command("map", epilog="Example: swarmtopo map runs/two-holes --out runs/two-holes/map --metric hybrid --landmarks 300")
 def map_command(
     log_dir: Path = typer.Argument(..., help="Log folder: events.csv|parquet, optional status, meta.json."),
@@ -175,14 +189,26 @@ def map_command(
     subsample: str = typer.Option("maxmin", "--subsample", help="maxmin | knn | probabilistic."),
     landmarks: Optional[int] = typer.Option(
         None, "--landmarks", min=3,
-        help="Number of landmarks L (default: the fewest that meet the sampling guarantee, at most 1000)."),
+        help="Number of landmarks L per region and window (default: the fewest that meet the sampling "
+             "guarantee, at most 400)."),
     window: Optional[str] = typer.Option(None, "--window", callback=_parse_window,
                                          help="Time window T0:T1 in seconds (either end may be empty)."),
     maxdim: int = typer.Option(1, "--maxdim", min=1, max=2, help="Highest homology dimension (1 or 2)."),
     seed: int = typer.Option(0, "--seed", help="Seed of landmark start and MDS."),
-    classifier: str = typer.Option(
-        "default", "--classifier",
-        help="Betti classifier: default (trained by the project), paper (the paper's Theta*), or a JSON file."),
+    hop_cost: Optional[float] = typer.Option(
+        None, "--hop-cost", min=0.0,
+        help="Per-hop cost h in seconds on the encounter graph; 0 = the paper's metric "
+             "(default: r_d / v_c from meta.json, else from the data)."),
+    window_length: Optional[str] = typer.Option(
+        None, "--window-length", callback=_parse_window_length,
+        help="Seconds of the time windows whose maps vote; 'none' maps the whole log at once (default 15)."),
+    classifier: Optional[str] = typer.Option(
+        None, "--classifier",
+        help="Betti classifier: default (tuned on the accuracy benchmark), paper-form (the paper's form trained "
+             "our way), paper (the paper's Theta*), or a JSON file."),
+    paper: bool = typer.Option(
+        False, "--paper",
+        help="Run exactly the paper's pipeline: no per-hop cost, the whole log, the paper's Theta*."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
@@ -192,11 +218,19 @@ def map_command(
     from .pipeline import MapConfig
 
     _check_verbosity(quiet, verbose)
+    if paper:
+        given = [name for name, value in (("--hop-cost", hop_cost), ("--window-length", window_length),
+                                          ("--classifier", classifier)) if value is not None]
+        if given:
+            raise typer.BadParameter(f"--paper fixes {', '.join(given)}; drop one or the other")
+        hop_cost, window_length, classifier = 0.0, "none", "paper"
     out_dir = out_dir or log_dir / "map"
-    model = load_classifier(classifier)
+    model = load_classifier(classifier or "default")
     log = read_log(log_dir)
-    config = MapConfig(metric=metric, subsample=subsample, landmarks=landmarks,
-                       window=window, maxdim=maxdim, seed=seed)
+    config = MapConfig(metric=metric, subsample=subsample, landmarks=landmarks, window=window, maxdim=maxdim,
+                       seed=seed, hop_cost=hop_cost,
+                       window_length=(MapConfig.window_length if window_length is None else
+                                      None if window_length == "none" else float(window_length)))
     if verbose:
         _detail(f"log {log_dir}: {log.n_events} encounters of {log.n_agents} agents over {log.duration:g} s")
     tmap, written = _run_map(log, config, log_dir, out_dir, quiet, verbose, classifier=model)
@@ -212,9 +246,10 @@ def demo(
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
-    """Simulate the paper's Fig. "encmds" scenario and map it.
+    """Simulate the paper's Fig. "encmds" arena and map it.
 
-    A 500 mm square with one hole, 200 agents, 20 s of data: prints the recovered
+    A 500 mm square with one hole, 200 agents, 30 s of data (the accuracy benchmark's
+    smallest budget; the paper's figure has 20 s): prints the recovered
     Betti numbers beside the true ones and where the figures were written.
     """
     from .arena import default_arena
@@ -225,11 +260,12 @@ def demo(
     _check_verbosity(quiet, verbose)
     world = default_arena()
     with _progress("simulating", quiet) as tick:
-        sim = run(world, 200, 20.0, rng=seed, truth=True, trajectory_every=0.5, progress=tick)
+        sim = run(world, DEMO_AGENTS, DEMO_SECONDS, rng=seed, truth=True, trajectory_every=0.5, progress=tick)
     log_dir = out_dir / "log"
     write_log(sim.log, log_dir, truth=sim.truth, trajectories=sim.trajectories, arena=world)
     if verbose:
-        _detail(f"simulated: {sim.log.n_events} encounters of 200 agents over 20 s; log: {log_dir}")
+        _detail(f"simulated: {sim.log.n_events} encounters of {DEMO_AGENTS} agents over {DEMO_SECONDS:g} s; "
+                f"log: {log_dir}")
     tmap, written = _run_map(sim.log, MapConfig(seed=seed), log_dir, out_dir, quiet, verbose)
     if not quiet:
         _print_verdict(tmap, truth=world.betti)
@@ -336,6 +372,110 @@ def _sweep_progress(quiet: bool, verbose: bool = False, label: str = "sweep"):
         yield lambda done, total, failed: bar.update(task, completed=done, total=total, failed=failed)
 
 
+bench_app = typer.Typer(no_args_is_help=True, help="Benchmarks that measure swarmtopo's answers.")
+app.add_typer(bench_app, name="bench")
+
+
+@bench_app.command("accuracy", epilog="Example: swarmtopo bench accuracy --quick --store accuracy.duckdb --workers 2  "
+                                      "(run it again after Ctrl-C: finished maps are kept)")
+def bench_accuracy(
+    quick: bool = typer.Option(False, "--quick", help="10 reporting cases per cell instead of 30 (minutes, not an hour)."),
+    store: Path = typer.Option(Path("accuracy.duckdb"), "--store", help="DuckDB result store (resumable)."),
+    out_dir: Path = typer.Option(Path("accuracy"), "--out", help="Folder for accuracy.md, accuracy.json, plan.json."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Address of an existing Dask scheduler."),
+    workers: Optional[int] = typer.Option(None, "--workers", min=1,
+                                          help="Worker processes of the local cluster (default: all cores)."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
+) -> None:
+    """Exact-match accuracy of (beta_0, beta_1) on the frozen suite of simulated arenas.
+
+    Maps every reporting case (0-3 holes x three swarm budgets, and two rooms) with the
+    default pipeline and the paper's, from log folders stripped of ground truth, on
+    Dask; prints the table with Wilson 95 % intervals and the confidence's reliability.
+    """
+    import shlex
+    import time
+
+    from .experiments.accuracy import markdown, run_benchmark
+    from .io import write_json
+    from .plan import fit_plan
+
+    _check_verbosity(quiet, verbose)
+    command = "swarmtopo " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+    start = time.perf_counter()
+    try:
+        with _sweep_progress(quiet, verbose, label="accuracy") as tick:
+            summary = run_benchmark(store, quick=quick, scheduler=scheduler, workers=workers, progress=tick)
+    except KeyboardInterrupt:
+        if not quiet:
+            err.print(f"interrupted: finished maps are saved in {store}; run the same command again to run the rest",
+                      markup=False, highlight=False, soft_wrap=True)
+        raise typer.Exit(130) from None
+    summary["wall_seconds"] = time.perf_counter() - start
+    text = markdown(summary, command)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = [write_json({k: v for k, v in summary.items()}, out_dir / "accuracy.json")]
+    (out_dir / "accuracy.md").write_text(text, encoding="utf-8")
+    written.append(out_dir / "accuracy.md")
+    try:
+        written.append(write_json(fit_plan(summary["records"], source=command).to_json(), out_dir / "plan.json"))
+    except SwarmtopoError as exc:
+        _warn(f"no plan.json: {exc}", quiet)
+    if not quiet:
+        out.print(text, markup=False, highlight=False, soft_wrap=True)
+        out.print(f"wrote {', '.join(str(p) for p in written)}", markup=False, highlight=False, soft_wrap=True)
+
+
+@app.command(epilog="Examples: swarmtopo plan --area 250000 --agents 200 --duration 30;  "
+                    "swarmtopo plan --area 250000 --agents 200 --target 0.95")
+def plan(
+    area: float = typer.Option(..., "--area", help="Area inside the outer walls, mm^2."),
+    agents: Optional[int] = typer.Option(None, "--agents", min=1, help="Swarm size N."),
+    duration: Optional[float] = typer.Option(None, "--duration", help="Seconds of data T."),
+    target: Optional[float] = typer.Option(None, "--target", help="Wanted exact-match accuracy, e.g. 0.95."),
+    model_file: Optional[Path] = typer.Option(None, "--model", help="plan.json of a benchmark run "
+                                                                    "(default: the shipped one)."),
+) -> None:
+    """What accuracy a deployment will get, or the agents / time it needs for a target.
+
+    Give --agents and --duration for the expected accuracy; or one of them and --target
+    for the other.  Answers come from the accuracy benchmark (docs/accuracy.md).
+    """
+    from .plan import load_plan
+
+    given = {"agents": agents is not None, "duration": duration is not None, "target": target is not None}
+    if sum(given.values()) != 2:
+        raise typer.BadParameter("give two of --agents, --duration and --target (the third is computed)")
+    model = load_plan(model_file)
+    if target is None:
+        p = model.accuracy(area, agents, duration)
+        out.print(f"expected exact (beta_0, beta_1) accuracy: {100 * p:.0f}% "
+                  f"({agents} agents x {duration:g} s in {area:g} mm^2)", markup=False, highlight=False)
+        n, t = agents, duration
+    elif agents is None:
+        n = model.agents_for(area, duration, target)
+        t = duration
+        out.print(_plan_answer("agents", n, f"for {100 * target:g}% in {duration:g} s over {area:g} mm^2"),
+                  markup=False, highlight=False)
+    else:
+        t = model.duration_for(area, agents, target)
+        n = agents
+        out.print(_plan_answer("seconds of data", t, f"for {100 * target:g}% with {agents} agents over {area:g} mm^2"),
+                  markup=False, highlight=False)
+    if np.isfinite(n) and np.isfinite(t) and not model.inside(area, n, t):
+        lo, hi = model.density_range
+        t_lo, t_hi = model.duration_range
+        out.print(f"note: outside the benchmark's range ({lo * 1e6:.0f}-{hi * 1e6:.0f} agents per m^2, "
+                  f"{t_lo:g}-{t_hi:g} s): an extrapolation", markup=False, highlight=False)
+
+
+def _plan_answer(what: str, value: float, condition: str) -> str:
+    if not np.isfinite(value):
+        return f"no number of {what} reaches that {condition} in the benchmark's model"
+    return f"needed: {math.ceil(value)} {what} {condition}"
+
+
 def _run_map(log, config, log_dir: Path, out_dir: Path, quiet: bool, verbose: bool = False, classifier=None):
     """Map, write map.json and figures; ground truth beside the log only colours pictures,
     and a broken ground-truth file costs a warning, never the map."""
@@ -362,6 +502,11 @@ def _map_details(tmap) -> None:
                 f"k-NN scale {r.scales.knn:.3g} s); longest H1 bars {longest} s; "
                 f"threshold {', '.join(f'{v:.3g} s' for v in r.thresholds.values())}; "
                 f"{len(r.cycles)} loop(s) found")
+        if len(r.windows) > 1:
+            _detail(f"region {r.component}: {len(r.windows)} windows of {tmap.config.window_length:g} s counted "
+                    f"{[w.betti.get(1) for w in r.windows]} holes; vote {r.betti.get(1)}, shown: window "
+                    f"{r.window} [{r.windows[r.window].t0:.1f}, {r.windows[r.window].t1:.1f}] s")
+    _detail(f"per-hop cost h = {tmap.hop_cost[0]:.3g} s ({tmap.hop_cost[1]})")
 
 
 def _ground_truth(log, log_dir: Path, quiet: bool):
@@ -412,6 +557,8 @@ def _print_verdict(tmap, truth) -> None:
         out.print(f"true:      beta_0 = {truth[0]}, beta_1 = {truth[1]}")
     for warning in tmap.warnings:
         out.print(f"warning: {warning}", markup=False)
+    for line in tmap.advice():
+        out.print(f"advice: {line}", markup=False, highlight=False, soft_wrap=True)
     for small in tmap.too_little_data:
         out.print(f"note: {small['events']} encounter(s) of {small['agents']} agent(s) never linked to the "
                   "rest: too little data, not counted as a region")

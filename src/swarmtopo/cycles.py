@@ -189,15 +189,15 @@ def region_cycles(region, result: PersistenceResult | None = None, *,
     ``region`` is a :class:`swarmtopo.pipeline.RegionMap`; ``result`` its persistence
     with cocycles (``rips_persistence(region.landmarks.distances, cocycles=True)``),
     computed here when not given (the adapter makes its diagram identical to the
-    region's).  The bars longer than ``region.thresholds[1]`` are the ones the
-    classifier counts, and each loop carries its landmarks' log event indices.
+    region's).  The bars in ``region.counted[1]`` are the ones the classifier counts,
+    and each loop carries its landmarks' log event indices.
     """
-    if 1 not in region.thresholds:
+    if 1 not in region.counted:
         return []
     distances = region.landmarks.distances
     if result is None:
         result = rips_persistence(distances, maxdim=1, cocycles=True)
-    cycles = representative_cycles(distances, result, threshold=region.thresholds[1], position=position)
+    cycles = representative_cycles(distances, result, region.counted[1], position=position)
     events = np.asarray(region.landmark_events)
     return [replace(c, events=events[c.landmarks]) for c in cycles]
 

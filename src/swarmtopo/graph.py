@@ -51,6 +51,20 @@ each term is at most t_{e_{r+1}} - t_{e_r} >= 0 and the sum telescopes to
 t_j - t_i = w^k_ij.  Replacing each edge of a shortest G-path by its chain path
 gives a C-path of no larger weight.  ∎
 
+Per-hop cost (swarmtopo's variant, not the paper's)
+---------------------------------------------------
+With ``hop_cost`` h > 0 every chain edge weighs w^k_{e_p e_{p+1}} + h, zero-weight
+ones included (one stop interval, equal times), so nothing is merged: events at one
+instant are up to r_d apart, and agents in contact at one instant can form chains
+across the arena (at the start of a run a dense swarm percolates), which at zero cost
+would be wormholes.  Consecutive
+events of one agent are at most v_c |t_i - t_j| + r_d apart in the arena (each event
+is within r_d/2 of the agent), so h ~ r_d / v_c makes the path length track distance
+walked; at h = 0 a path changes agent at every encounter for free and, in a dense
+swarm, distances shrink into noisy hop counts.  This metric lives on the chain graph
+C: it is *not* the paper's all-pairs graph G with h added to every edge (there a path
+pays one h for skipping many events).
+
 Zero weights and merged nodes
 -----------------------------
 Zero-weight chain edges (stop intervals, static agents, equal times) are contracted
@@ -185,7 +199,8 @@ class EncounterGraph:
 
 
 def build_graph(log: EncounterLog, metric: str = "plain", *,
-                window: tuple[float | None, float | None] | None = None) -> EncounterGraph:
+                window: tuple[float | None, float | None] | None = None,
+                hop_cost: float = 0.0) -> EncounterGraph:
     """Sparse chain graph of the events of ``log`` under an encounter metric.
 
     Parameters
@@ -199,6 +214,9 @@ def build_graph(log: EncounterLog, metric: str = "plain", *,
     window
         ``(t0, t1)``: keep only events with t0 <= t_i <= t1 (None = unbounded), as
         :meth:`EncounterLog.window`.  Stop intervals always come from the whole log.
+    hop_cost
+        h >= 0, seconds, added to every chain edge (see "Per-hop cost" in the module
+        docstring); 0 (default) is the paper's metric.
 
     Returns
     -------
@@ -219,8 +237,15 @@ def build_graph(log: EncounterLog, metric: str = "plain", *,
     intervals = _stop_intervals(log, metric)
     if intervals is not None and len(intervals[0]):
         weight[_within_one_interval(pair_agent, t[first], t[second], intervals, log.n_agents)] = 0.0
+    weight += _check_hop_cost(hop_cost)
     event_index = np.arange(start, stop, dtype=np.int64)
     return _contract(t, first, second, weight, event_index, metric)
+
+
+def agent_gaps(log: EncounterLog) -> np.ndarray:
+    """|t_i - t_j| of every pair of consecutive events of one agent (the chain edges)."""
+    _, first, second = _agent_chains(log.a, log.b)
+    return log.t[second] - log.t[first]
 
 
 def literal_distances(log: EncounterLog, metric: str,
@@ -258,6 +283,16 @@ def literal_distances(log: EncounterLog, metric: str,
 
 
 # -- construction steps ----------------------------------------------------------------
+def _check_hop_cost(hop_cost) -> float:
+    try:
+        h = float(hop_cost)
+    except (TypeError, ValueError):
+        h = float("nan")
+    if not (np.isfinite(h) and h >= 0.0):
+        raise InputError("hop cost must be a finite number of seconds >= 0", column="hop_cost", value=hop_cost)
+    return h
+
+
 def _check_metric(metric) -> None:
     if metric not in METRICS:
         raise InputError(f"unknown encounter metric; expected one of {', '.join(METRICS)}",

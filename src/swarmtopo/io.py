@@ -43,6 +43,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import shutil
 from pathlib import Path
 from typing import Any
@@ -236,11 +237,16 @@ def _read_ground_truth(directory, name: str, columns, id_columns, position_colum
     return path, table, out
 
 
+GROUND_TRUTH_META_KEYS = ("simulation", "seed")
+"""``meta.json`` keys of a simulated log that a deployment would not have: the
+simulator's record (it holds the arena's Betti numbers) and its seed."""
+
+
 def strip_ground_truth(src_dir, dst_dir) -> None:
     """Copy a log folder without its ground truth.
 
     ``dst_dir`` gets ``events.*``, ``status.*`` and ``meta.json`` without its
-    ``simulation`` key -- no ``arena.geojson``, ``truth.*``, ``trajectories.*`` and no
+    ``GROUND_TRUTH_META_KEYS`` -- no ``arena.geojson``, ``truth.*``, ``trajectories.*`` and no
     file outside the contract.  Used to prove that ``swarmtopo map`` needs nothing else.
     ``dst_dir`` must not exist yet or be empty.
     """
@@ -255,7 +261,8 @@ def strip_ground_truth(src_dir, dst_dir) -> None:
     if (src / "meta.json").is_file():
         meta = read_json(src / "meta.json")
         if isinstance(meta, dict):
-            meta.pop("simulation", None)
+            for key in GROUND_TRUTH_META_KEYS:
+                meta.pop(key, None)
         write_json(meta, dst / "meta.json")
 
 
@@ -561,7 +568,9 @@ def _csv_problem(path: Path, exc: Exception) -> str:
                       parse_options=pcsv.ParseOptions(invalid_row_handler=record))
     except pa.ArrowInvalid:
         pass
-    reason = str(exc).removeprefix("CSV parse error: ")
+    # pyarrow >= 26.0.1 prefixes its own "Row #N: " (a file line, header included):
+    # dropped, so the message names one row, counted like every other message here
+    reason = re.sub(r"^Row #\d+: ", "", str(exc).removeprefix("CSV parse error: "))
     if bad and bad[0].number is not None:  # number counts the header as row 1
         return f"row {bad[0].number - 1}: cannot parse CSV ({reason})"
     return f"cannot parse CSV ({reason})"

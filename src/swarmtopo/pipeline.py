@@ -31,11 +31,12 @@ from .classify import BettiClassifier, RegionScales, load_classifier
 from .cycles import Cycle, region_cycles
 from .embed import Embedding, mds
 from .errors import SwarmtopoError
-from .graph import METRICS, EncounterGraph, build_graph
+from .graph import METRICS, EncounterGraph, agent_gaps, build_graph
 from .io import jsonable
 from .landmarks import SUBSAMPLERS, Landmarks, knn_distances, knn_maxmin, maxmin, probabilistic_maxmin
 from .log import EncounterLog
-from .persistence import Diagram, rips_persistence
+from .persistence import Diagram, PersistenceResult, rips_persistence
+from .ratio import WindowBars, vote
 
 
 MIN_REGION_AGENTS = 3
@@ -46,6 +47,11 @@ AUTO_COVER_FACTOR = 1.5
 region's k-NN scale).  The landmarks' diagram is within bottleneck 2 r_cover of the
 whole cloud's, so subsampling moves no bar by more than 3 s: the order of the
 cloud's own Rips noise bars."""
+ADVICE_BELOW = 0.8
+"""A Betti number reported with less confidence than this comes with advice."""
+HOP_GAP_FACTOR = 2.0
+"""Without r_d and v_c in meta.json, the per-hop cost h is this many times the mean time
+between an agent's consecutive encounters (docs/accuracy.md, "Real traces")."""
 STAGES = ("graph", "landmarks", "persistence", "embedding", "classify", "cycles")
 """Stage names passed to ``map_encounters``'s progress callback, in order."""
 
@@ -60,6 +66,20 @@ class MapConfig:
         Encounter metric: ``plain``, ``contracted`` or ``hybrid`` (paper definitions;
         hybrid = contracted + static agents as unbounded stops; it falls back to
         contracted without static agents and to plain without status).
+    hop_cost
+        Per-hop cost h (seconds) added to every positive chain edge of the graph
+        (:mod:`swarmtopo.graph`); 0 is the paper's metric; None (default) takes
+        r_d / v_c from the log's meta.json, or, for a trace without them,
+        ``HOP_GAP_FACTOR`` x the mean time between an agent's encounters.
+    window_length
+        Length (s) of the time windows each region is mapped in; the region's Betti
+        numbers are voted across them (:func:`swarmtopo.ratio.vote`).  None maps the
+        whole log at once (the paper).
+    window_step
+        Seconds between the starts of consecutive windows; None (default) = half the
+        window length, so windows overlap by half and a log of T seconds gets
+        ceil(2 T / window_length) - 1 of them, evenly spaced from the first event to
+        the last.
     subsample
         Landmark subsampler: ``maxmin``, ``knn`` (KNN-filtered maxmin) or
         ``probabilistic`` (probabilistic maxmin).
@@ -70,8 +90,9 @@ class MapConfig:
         region's k-NN scale, at most ``max_landmarks``; maxmin-type selection is
         greedy, so these are the first landmarks of a longer run.
     max_landmarks
-        Cap of the automatic landmark count per region (default 1000: persistence
-        stays around a second).
+        Cap of the automatic landmark count per region and window (default 400, the
+        setting the accuracy benchmark measured; persistence stays well under a
+        second).
     window
         Optional time window (t0, t1) on the events, seconds; None = whole log.
     maxdim
@@ -92,9 +113,12 @@ class MapConfig:
     """
 
     metric: str = "hybrid"
+    hop_cost: float | None = None
+    window_length: float | None = 20.0
+    window_step: float | None = None
     subsample: str = "maxmin"
     landmarks: int | None = None
-    max_landmarks: int = 1000
+    max_landmarks: int = 400
     window: tuple[float | None, float | None] | None = None
     maxdim: int = 1
     seed: int | None = 0
@@ -115,6 +139,12 @@ class MapConfig:
             raise SwarmtopoError(f"landmarks must be at least 3, got {self.landmarks}")
         if self.max_landmarks < 3:
             raise SwarmtopoError(f"max_landmarks must be at least 3, got {self.max_landmarks}")
+        if self.hop_cost is not None and not (np.isfinite(self.hop_cost) and self.hop_cost >= 0):
+            raise SwarmtopoError(f"hop_cost must be a number of seconds >= 0, got {self.hop_cost}")
+        if self.window_length is not None and not (np.isfinite(self.window_length) and self.window_length > 0):
+            raise SwarmtopoError(f"window_length must be a positive number of seconds, got {self.window_length}")
+        if self.window_step is not None and not (np.isfinite(self.window_step) and self.window_step > 0):
+            raise SwarmtopoError(f"window_step must be a positive number of seconds, got {self.window_step}")
         if self.maxdim not in (1, 2):
             raise SwarmtopoError(f"maxdim must be 1 or 2, got {self.maxdim}")
         if self.embed_dim not in (0, 2, 3):
@@ -130,8 +160,35 @@ class MapConfig:
 
 
 @dataclass(eq=False)
+class WindowMap:
+    """One region's events in one time window [t0, t1]: landmarks and persistence."""
+
+    t0: float
+    t1: float
+    n_events: int
+    landmarks: Landmarks
+    landmark_events: np.ndarray  # (L,) original log event index of each landmark
+    scales: RegionScales
+    persistence: PersistenceResult
+    betti: dict[int, int] = field(default_factory=dict)  # this window's count, set by the vote
+
+    @property
+    def diagram(self) -> Diagram:
+        return self.persistence.diagram
+
+    def to_json(self) -> dict[str, Any]:
+        return {"t0": self.t0, "t1": self.t1, "events": self.n_events, "landmarks": int(len(self.landmarks.nodes)),
+                "cover_radius": float(self.scales.cover_radius), "knn_scale": float(self.scales.knn),
+                "betti": {str(n): int(v) for n, v in self.betti.items()}}
+
+
+@dataclass(eq=False)
 class RegionMap:
-    """One region: a connected component of the encounter graph with enough events."""
+    """One region: a connected component of the encounter graph with enough events.
+
+    Its landmarks, diagram, loops and picture are those of its representative window
+    ``windows[window]`` (the only one without windowing); ``betti`` is the vote.
+    """
 
     component: int
     n_events: int
@@ -141,11 +198,14 @@ class RegionMap:
     diagram: Diagram
     scales: RegionScales
     thresholds: dict[int, float]  # bar-length threshold per dimension n >= 1
+    counted: dict[int, np.ndarray]  # indices of the counted bars of the diagram, per dimension n >= 1
     betti: dict[int, int]
     confidence: dict[int, float | None]  # P(betti[n] is right), n >= 1
     cycles: list[Cycle]  # a loop of landmarks round each counted H1 bar (empty if not asked)
     warnings: list[str]
     embedding: Embedding | None
+    windows: list[WindowMap]
+    window: int  # index of the representative window
 
 
 @dataclass(eq=False)
@@ -170,12 +230,30 @@ class TopologicalMap:
     timings: dict[str, float]
     n_events: int
     n_agents: int
+    hop_cost: tuple[float, str] = (0.0, "given")  # (h used, where it came from)
     software: dict[str, str] = field(default_factory=dict)
 
     @property
     def warnings(self) -> list[str]:
         """Reasons to doubt the map, from every region."""
         return [w for r in self.regions for w in r.warnings]
+
+    def advice(self) -> list[str]:
+        """What would raise a confidence below ``ADVICE_BELOW`` (empty otherwise)."""
+        low = [n for n, p in sorted(self.confidence.items()) if p is not None and p < ADVICE_BELOW]
+        if not low:
+            return []
+        lines = [f"beta_{n} = {self.betti[n]} is uncertain ({100 * self.confidence[n]:.0f}% confidence)" for n in low]
+        for r in self.regions:
+            counts = [w.betti.get(1) for w in r.windows]
+            if len(set(counts)) > 1:
+                lines.append(f"region {r.component}: its {len(counts)} time windows counted {counts} holes")
+        step = self.config.window_step or (self.config.window_length or 20.0) / 2
+        lines.append(f"to raise it: record longer (each extra {step:g} s adds a window to "
+                     f"the vote), use more agents than {self.n_agents} (denser windows), or leave some agents "
+                     "static (hybrid metric: free links across time); 'swarmtopo plan --area A --agents N "
+                     "--target 0.95' tells how much")
+        return lines
 
     def to_json(self) -> dict[str, Any]:
         """The map.json document (deaths of infinite bars as null)."""
@@ -185,6 +263,7 @@ class TopologicalMap:
             "diagrams": self.diagram.to_json(),
             "classifier": self.classifier,
             "warnings": self.warnings,
+            "advice": self.advice(),
             "regions": [
                 {
                     "component": r.component,
@@ -197,6 +276,8 @@ class TopologicalMap:
                     "betti": {str(k): int(v) for k, v in sorted(r.betti.items())},
                     "confidence": {str(k): v for k, v in sorted(r.confidence.items())},
                     "cycles": [c.to_json() for c in r.cycles],
+                    "windows": [w.to_json() for w in r.windows],
+                    "window": r.window,
                     "diagrams": r.diagram.to_json(),
                     "mds_stress": None if r.embedding is None else float(r.embedding.stress),
                     "warnings": r.warnings,
@@ -204,7 +285,8 @@ class TopologicalMap:
                 for r in self.regions
             ],
             "too_little_data": self.too_little_data,
-            "params": jsonable(asdict(self.config)),
+            "params": {**jsonable(asdict(self.config)), "hop_cost_used": self.hop_cost[0],
+                       "hop_cost_source": self.hop_cost[1]},
             "log": {"events": self.n_events, "agents": self.n_agents},
             "timings": {k: round(v, 6) for k, v in self.timings.items()},
             "software": {**self.software, "persistence_backend": self.diagram.backend},
@@ -249,7 +331,8 @@ def map_encounters(
             f"the log has {log.n_events} event(s); at least 2 encounters are needed to build a map")
     say("graph")
     t0 = time.perf_counter()
-    graph = build_graph(log, config.metric, window=config.window)
+    hop_cost, hop_source = resolve_hop_cost(log, config.hop_cost)
+    graph = build_graph(log, config.metric, window=config.window, hop_cost=hop_cost)
     n_comp, labels = graph.components()
     event_comp = labels[graph.node_of_event]
     events_per_comp = np.bincount(event_comp, minlength=n_comp)
@@ -266,57 +349,59 @@ def map_encounters(
 
     shares = (_share_landmarks(config.landmarks, events_per_comp[regions_idx]) if config.landmarks
               else [None] * len(regions_idx))
+    spans = _windows(graph.event_t, config.window_length, config.window_step)
+    # a window with fewer events than a region needs (a gap in a real trace) is skipped
+    window_graphs = ([(None, graph, labels)] if len(spans) == 1 else
+                     [(span, *_with_components(build_graph(log, config.metric, window=span, hop_cost=hop_cost)))
+                      for span in spans if _events_within(log, span) >= config.min_region_events])
     regions: list[RegionMap] = []
     for comp, n_land in zip(regions_idx, shares):
-        sub = graph.subgraph(np.flatnonzero(labels == comp))
-        say("landmarks")
-        t0 = time.perf_counter()
-        knn_scale = _knn_scale(sub, config.knn_k)
-        if n_land is None:
-            land = _subsample(sub, config, min(config.max_landmarks, sub.n_nodes), rng)
-            land = _first_covering(land, AUTO_COVER_FACTOR * knn_scale)
-        else:
-            land = _subsample(sub, config, int(min(n_land, sub.n_nodes)), rng)
-        scales = RegionScales(knn=knn_scale, cover_radius=float(land.cover_radius))
-        timings["landmarks"] += time.perf_counter() - t0
-        say("persistence")
-        t0 = time.perf_counter()
-        # with loops asked for, one run that also keeps the cocycles they are found from
-        persistence = rips_persistence(land.distances, maxdim=config.maxdim, cocycles=config.cycles)
-        dgm = persistence.diagram
-        timings["persistence"] += time.perf_counter() - t0
-        say("embedding")
-        t0 = time.perf_counter()
-        emb = (mds(land.distances, dim=config.embed_dim, rng=rng)
-               if config.embed_dim and len(land.nodes) > config.embed_dim else None)
-        timings["embedding"] += time.perf_counter() - t0
+        region_events = graph.event_index[event_comp == comp]
+        windows = [w for span, wgraph, wlabels in window_graphs
+                   if (w := _map_window(span, _region_part(wgraph, wlabels, region_events, log, config),
+                                        n_land, config, rng, timings, say)) is not None]
+        if not windows:  # no window holds enough of this region: map its whole log instead
+            whole = graph.subgraph(np.flatnonzero(labels == comp))
+            windows = [_map_window(None, whole, n_land, config, rng, timings, say)]
         say("classify")
         t0 = time.perf_counter()
-        betti_region = classifier.betti(dgm)
-        confidence_region = classifier.confidence(dgm)
-        thresholds = classifier.thresholds(dgm)
+        bars = [WindowBars(w.diagram, w.scales.cover_radius) for w in windows]
+        betti_region, rep, counts = vote(classifier, bars)
+        for w, *window_counts in zip(windows, *counts.values()):
+            w.betti = dict(zip(counts, window_counts))
+        chosen = windows[rep]
+        confidence_region = classifier.region_confidence(bars)
+        counted = classifier.counted(chosen.diagram, chosen.scales.cover_radius)
+        thresholds = classifier.length_thresholds(chosen.diagram, chosen.scales.cover_radius)
         timings["classify"] += time.perf_counter() - t0
+        say("embedding")
+        t0 = time.perf_counter()
+        emb = (mds(chosen.landmarks.distances, dim=config.embed_dim, rng=rng)
+               if config.embed_dim and len(chosen.landmarks.nodes) > config.embed_dim else None)
+        timings["embedding"] += time.perf_counter() - t0
         regions.append(RegionMap(
             component=comp,
             n_events=int(events_per_comp[comp]),
             n_agents=int(agents_per_comp[comp]),
-            landmarks=land,
-            landmark_events=sub.representative_event()[land.nodes],
-            diagram=dgm,
-            scales=scales,
+            landmarks=chosen.landmarks,
+            landmark_events=chosen.landmark_events,
+            diagram=chosen.diagram,
+            scales=chosen.scales,
             thresholds=thresholds,
+            counted=counted,
             betti=betti_region,
             confidence=confidence_region,
             cycles=[],
-            warnings=_sampling_warnings(scales, len(land.nodes), config),
+            warnings=_sampling_warnings(chosen.scales, len(chosen.landmarks.nodes), config),
             embedding=emb,
+            windows=windows,
+            window=rep,
         ))
         if config.cycles:
             say("cycles")
             t0 = time.perf_counter()
-            regions[-1].cycles = region_cycles(regions[-1], persistence)
+            regions[-1].cycles = region_cycles(regions[-1], chosen.persistence)
             timings["cycles"] += time.perf_counter() - t0
-
     betti: dict[int, int | None] = {0: len(regions)}
     confidence: dict[int, float | None] = {0: classifier.beta0_confidence()}
     for n in range(1, config.maxdim + 1):
@@ -339,8 +424,87 @@ def map_encounters(
         timings=timings,
         n_events=graph.n_events,
         n_agents=log.n_agents,
+        hop_cost=(hop_cost, hop_source),
         software=software_versions(),
     )
+
+
+def _map_window(span, sub: EncounterGraph | None, n_land: int | None, config: MapConfig, rng,
+                timings: dict[str, float], say) -> "WindowMap | None":
+    """Landmarks and persistence of one region's events in one time window (None: too few)."""
+    if sub is None:
+        return None
+    say("landmarks")
+    t0 = time.perf_counter()
+    knn_scale = _knn_scale(sub, config.knn_k)
+    if n_land is None:
+        land = _subsample(sub, config, min(config.max_landmarks, sub.n_nodes), rng)
+        land = _first_covering(land, AUTO_COVER_FACTOR * knn_scale)
+    else:
+        land = _subsample(sub, config, int(min(n_land, sub.n_nodes)), rng)
+    timings["landmarks"] += time.perf_counter() - t0
+    say("persistence")
+    t0 = time.perf_counter()
+    # with loops asked for, one run that also keeps the cocycles they are found from
+    persistence = rips_persistence(land.distances, maxdim=config.maxdim, cocycles=config.cycles)
+    timings["persistence"] += time.perf_counter() - t0
+    t_lo, t_hi = (float(sub.event_t.min()), float(sub.event_t.max())) if span is None else span
+    return WindowMap(t0=t_lo, t1=t_hi, n_events=sub.n_events, landmarks=land,
+                     landmark_events=sub.representative_event()[land.nodes],
+                     scales=RegionScales(knn=knn_scale, cover_radius=float(land.cover_radius)),
+                     persistence=persistence)
+
+
+def resolve_hop_cost(log: EncounterLog, hop_cost: float | None) -> tuple[float, str]:
+    """(h, where it came from): the given value, else r_d / v_c from the log's meta.json,
+    else HOP_GAP_FACTOR x the mean time between an agent's consecutive encounters."""
+    if hop_cost is not None:
+        return float(hop_cost), "given"
+    r_d, v_c = log.meta.get("r_d"), log.meta.get("v_c")
+    if all(isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) and x > 0 for x in (r_d, v_c)):
+        return float(r_d) / float(v_c), "r_d / v_c from meta.json"
+    gaps = agent_gaps(log)
+    gaps = gaps[gaps > 0]
+    if not len(gaps):
+        return 0.0, "no agent met twice at different times: 0"
+    return HOP_GAP_FACTOR * float(gaps.mean()), f"{HOP_GAP_FACTOR:g} x mean time between an agent's encounters"
+
+
+def _windows(event_t: np.ndarray, length: float | None, step: float | None = None) -> list[tuple[float, float] | None]:
+    """Time windows of ``length`` s over [t_first, t_last], starts at most ``step`` apart
+    (default length / 2): 1 + ceil((span - length) / step) of them, evenly spaced from
+    the first event to the last; [None] (the whole log) without a length or when the
+    span is not longer than one window."""
+    t_first, t_last = float(event_t.min()), float(event_t.max())
+    if length is None or t_last - t_first <= length:
+        return [None]
+    step = length / 2 if step is None else step
+    n = 1 + int(np.ceil((t_last - t_first - length) / step - 1e-9))
+    return [(float(s), float(s) + length) for s in np.linspace(t_first, t_last - length, n)]
+
+
+def _events_within(log: EncounterLog, span: tuple[float, float]) -> int:
+    return int(np.searchsorted(log.t, span[1], side="right") - np.searchsorted(log.t, span[0], side="left"))
+
+
+def _with_components(graph: EncounterGraph) -> tuple[EncounterGraph, np.ndarray]:
+    return graph, graph.components()[1]
+
+
+def _region_part(graph: EncounterGraph, labels: np.ndarray, region_events: np.ndarray, log: EncounterLog,
+                 config: MapConfig) -> EncounterGraph | None:
+    """The largest component of ``graph`` among the region's events, if it is big enough
+    to map (``min_region_events`` events, ``MIN_REGION_AGENTS`` agents); else None."""
+    inside = np.isin(graph.event_index, region_events)
+    if not inside.any():
+        return None
+    comps, sizes = np.unique(labels[graph.node_of_event[inside]], return_counts=True)
+    comp = comps[np.argmax(sizes)]
+    if sizes.max() < config.min_region_events:
+        return None
+    sub = graph.subgraph(np.flatnonzero(labels == comp))
+    agents = np.unique(np.concatenate([log.a[sub.event_index], log.b[sub.event_index]]))
+    return sub if len(agents) >= MIN_REGION_AGENTS else None
 
 
 def software_versions() -> dict[str, str]:
@@ -377,12 +541,16 @@ def _knn_scale(graph: EncounterGraph, k: int) -> float:
 
 
 def _sampling_warnings(scales: RegionScales, n_landmarks: int, config: MapConfig) -> list[str]:
-    """Why a region's answer may be unreliable (empty when it is not)."""
-    if scales.cover_radius > AUTO_COVER_FACTOR * scales.knn:
+    """Why a region's answer may be unreliable (empty when it is not).
+
+    A landmark count the user fixed is checked against the sampling guarantee; the
+    automatic count's cap is the benchmarked setting (its accuracy is measured with
+    the cap in force), so reaching it is not a warning.
+    """
+    if config.landmarks and scales.cover_radius > AUTO_COVER_FACTOR * scales.knn:
         return [f"landmarks too sparse: {n_landmarks} landmarks leave a covering radius of "
                 f"{scales.cover_radius:.3g} s, over {AUTO_COVER_FACTOR:g} x the cloud's k-NN scale "
-                f"{scales.knn:.3g} s, so subsampling noise can pass the threshold; use more landmarks"
-                + ("" if config.landmarks else f" (raise max_landmarks above {config.max_landmarks})")]
+                f"{scales.knn:.3g} s, so subsampling noise can pass the threshold; use more landmarks"]
     return []
 
 

@@ -25,6 +25,9 @@ Format (``examples/sweep-small.toml`` is a commented example)::
 
     [map]
     metric = "hybrid"         # plain | contracted | hybrid (default hybrid)
+    hop_cost = "auto"         # per-hop cost h, s: a number >= 0 (0 = the paper) or "auto" (default)
+    window_length = 20.0      # windows voted over, s: a number > 0 or "none" (whole log, the paper)
+    window_step = "auto"      # s between window starts: a number > 0 or "auto" (half the length)
     subsample = "maxmin"      # maxmin | knn | probabilistic (default maxmin)
     landmarks = "auto"        # an integer L >= 3, or "auto" (default)
     max_landmarks = 1000      # cap of the automatic count (only with landmarks = "auto")
@@ -135,6 +138,18 @@ def _shape_set(value) -> tuple[str, ...]:
     return tuple(sorted(set(shapes)))
 
 
+def _or_word(word: str, check: Callable[[Any], float]) -> Callable[[Any], Any]:
+    """A number passing ``check``, or the string ``word`` ("auto", "none")."""
+    def either(value):
+        if value == word:
+            return value
+        try:
+            return check(value)
+        except _Bad as exc:
+            raise _Bad(f"{exc} or \"{word}\"") from None
+    return either
+
+
 def _landmarks(value):
     if value == "auto":
         return value
@@ -168,6 +183,9 @@ PARAMS: tuple[Param, ...] = (
     Param("swarm", "static_fraction", 0.0, _number(0.0, strict=False, hi=1.0), "DOUBLE"),
     Param("swarm", "static_time", 0.0, _number(0.0, strict=False), "DOUBLE"),
     Param("map", "metric", "hybrid", _choice(METRICS), "TEXT"),
+    Param("map", "hop_cost", "auto", _or_word("auto", _number(0.0, strict=False)), "DOUBLE"),
+    Param("map", "window_length", MapConfig().window_length, _or_word("none", _number(0.0, strict=True)), "DOUBLE"),
+    Param("map", "window_step", "auto", _or_word("auto", _number(0.0, strict=True)), "DOUBLE"),
     Param("map", "subsample", "maxmin", _choice(tuple(SUBSAMPLERS)), "TEXT"),
     Param("map", "landmarks", "auto", _landmarks, "INTEGER"),
     Param("map", "max_landmarks", MapConfig().max_landmarks, _integer(3), "INTEGER"),
@@ -196,6 +214,10 @@ class Job:
     files
         ``(key, absolute path)`` of the job's input files (``arena.path``,
         ``map.classifier``); not part of the key, whose config holds their SHA-256.
+    case_seed
+        Seed of the arena and simulation streams shared by jobs that map the same
+        simulated case in different ways (the accuracy benchmark's pipelines); None:
+        every stream comes from the job's own seed.  Part of the key when set.
     """
 
     sweep: str
@@ -203,6 +225,7 @@ class Job:
     replicate: int
     salt: str = ""
     files: tuple[tuple[str, str], ...] = ()
+    case_seed: int | None = None
 
     @property
     def config(self) -> dict[str, Any]:
@@ -221,9 +244,13 @@ class Job:
 
     def stream_seeds(self) -> dict[str, int]:
         """Independent seeds of the job's streams (``STREAMS``), spawned from
-        ``SeedSequence(seed)``: one 64-bit integer each."""
+        ``SeedSequence(seed)``: one 64-bit integer each.  With ``case_seed`` the arena
+        and simulation streams are spawned from it instead (:func:`case_streams`)."""
         children = np.random.SeedSequence(self.seed).spawn(len(STREAMS))
-        return {name: int(child.generate_state(1, np.uint64)[0]) for name, child in zip(STREAMS, children)}
+        seeds = {name: int(child.generate_state(1, np.uint64)[0]) for name, child in zip(STREAMS, children)}
+        if self.case_seed is not None:
+            seeds.update(case_streams(self.case_seed))
+        return seeds
 
     def file(self, key: str) -> str | None:
         """Absolute path of the input file of ``key`` (``"arena.path"`` or
@@ -234,7 +261,15 @@ class Job:
     def _digest(self) -> bytes:
         """SHA-256 of the canonical JSON of (config, replicate, salt), computed once per job."""
         identity = {"config": json.loads(self.config_json), "replicate": self.replicate, "salt": self.salt}
+        if self.case_seed is not None:
+            identity["case_seed"] = self.case_seed
         return hashlib.sha256(canonical_json(identity).encode()).digest()
+
+
+def case_streams(case_seed: int) -> dict[str, int]:
+    """The arena and simulation seeds of a shared case (``Job.case_seed``)."""
+    children = np.random.SeedSequence(case_seed).spawn(2)
+    return {name: int(child.generate_state(1, np.uint64)[0]) for name, child in zip(("arena", "simulation"), children)}
 
 
 @dataclass(frozen=True)
@@ -340,11 +375,12 @@ def expand_grid(document: dict, *, source: str = "<grid>", base_dir=None,
 
 def flat_columns(config: dict) -> dict[str, Any]:
     """One value per ``PARAMS`` key (None where the config does not use it; ``landmarks``
-    None for "auto"): the store's flattened grid columns."""
+    and ``hop_cost`` None for "auto", ``window_length`` None for "none"): the store's
+    flattened grid columns."""
     flat = {}
     for p in PARAMS:
         value = config.get(p.table, {}).get(p.name)
-        flat[p.name] = None if value == "auto" else value
+        flat[p.name] = None if value in ("auto", "none") else value
     return flat
 
 
@@ -422,7 +458,10 @@ def _canonical(point: dict, inputs: _InputFiles, fail):
             fail(f"[swarm] static_time = {_toml(swarm['static_time'])}",
                  f"after the end of the run (duration = {swarm['duration']:g} s)")
 
-    mapping = {name: point[("map", name)] for name in ("metric", "subsample", "landmarks", "maxdim", "classifier")}
+    mapping = {name: point[("map", name)]
+               for name in ("metric", "hop_cost", "window_length", "subsample", "landmarks", "maxdim", "classifier")}
+    if mapping["window_length"] != "none":
+        mapping["window_step"] = point[("map", "window_step")]
     if mapping["landmarks"] == "auto":
         mapping["max_landmarks"] = point[("map", "max_landmarks")]
     if mapping["classifier"] not in PRESETS:
@@ -444,6 +483,8 @@ def _unused_reason(table: str, key: str, document: dict) -> str:
                 f"(only by {', '.join(repr(g) for g in users)})")
     if key == "static_time":
         return "not used: static_fraction is 0 (no agent stops for good)"
+    if key == "window_step":
+        return 'not used: window_length is "none" (the whole log at once)'
     return 'not used: landmarks is a number (max_landmarks caps landmarks = "auto")'
 
 

@@ -24,8 +24,10 @@ Settings the paper leaves open are fixed here once for all four experiments (mod
 constants; docs/reproduction.md says why): the 500 mm square with one centred 150 mm
 square hole (:func:`swarmtopo.arena.default_arena`), 200 agents in it (the same density
 of agents per mm^2 of free space elsewhere), the paper's motion parameters, r_d = 30 mm,
-dt = 0.1 s, the pipeline's defaults for everything else (maxmin, the automatic landmark
-count capped at 1000, landmark and MDS seed 0, the shipped default classifier).
+dt = 0.1 s, the paper's pipeline (no per-hop cost, the whole log at once, the paper's
+classifier form trained our way: the ``paper-form`` preset) and the pipeline's
+defaults for everything else (maxmin, the automatic landmark count capped at 1000,
+landmark and MDS seed 0).
 
 Seeds: run i of experiment NAME simulates with :func:`run_seed` (NAME, i), so a run
 with ``runs=n`` is the first n runs of the full experiment, and every CSV row names
@@ -57,6 +59,9 @@ from ..persistence import Diagram, rips_persistence, snr
 from ..pipeline import MapConfig, TopologicalMap, map_encounters, software_versions
 from ..sim import simulate
 from .clust import reproduce_clust
+
+PAPER_CLASSIFIER = "paper-form"
+"""The reproductions read Betti numbers with the paper's classifier form, trained our way."""
 
 Progress = Callable[[int, int, int], None]
 """Called as ``progress(done, total, failed)`` after every unit of work (as sweeps do)."""
@@ -412,7 +417,7 @@ def reproduce_land2(out: Path, *, runs: int | None = None, progress: Progress | 
     cloud_seed = run_seed("encmds", 0)
     sim = simulate(default_arena(), AGENTS, DURATION, rng=cloud_seed)
     graph = land2_graph(sim.log)
-    classifier = load_classifier("default")
+    classifier = load_classifier(PAPER_CLASSIFIER)
     tick = _Ticker(runs * len(LAND2_METHODS), progress)
     rows, first = [], {}
     for r in range(runs):
@@ -516,13 +521,15 @@ def _runs(name: str, runs: int | None) -> int:
 
 
 def _config(metric: str, *, picture: bool, window=None) -> MapConfig:
-    return MapConfig(metric=metric, embed_dim=3 if picture else 0, window=window, cycles=False)
+    """The paper's pipeline with one of its metrics."""
+    return MapConfig(metric=metric, hop_cost=0.0, window_length=None, embed_dim=3 if picture else 0,
+                     window=window, cycles=False)
 
 
 def _map(log, config: MapConfig) -> tuple[TopologicalMap | None, str]:
     """The map, or None and the reason when there is too little data to map."""
     try:
-        return map_encounters(log, config), ""
+        return map_encounters(log, config, classifier=load_classifier(PAPER_CLASSIFIER)), ""
     except SwarmtopoError as exc:
         return None, str(exc)
 
@@ -573,9 +580,10 @@ def _picked(picture: tuple, rows) -> dict[str, Any]:
 
 def _common_settings() -> dict[str, Any]:
     return {"motion": "MotionParams() (paper defaults)", "r_d": 30.0, "dt": 0.1,
-            "map_config": "MapConfig(metric=..., embed_dim=3 for pictures else 0), other fields default",
+            "map_config": "MapConfig(metric=..., hop_cost=0, window_length=None, embed_dim=3 for pictures else 0), "
+                          "other fields default",
             "seeds": "run_seed(NAME, i) = SeedSequence([crc32(NAME), i]).generate_state(1)[0]",
-            "classifier": load_classifier("default").describe(), "software": software_versions()}
+            "classifier": load_classifier(PAPER_CLASSIFIER).describe(), "software": software_versions()}
 
 
 def _fmt(value) -> str:

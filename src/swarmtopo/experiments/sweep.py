@@ -21,11 +21,12 @@ import logging
 import os
 import signal
 import socket
+import tempfile
 import threading
 import time
 from collections import Counter
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from datetime import datetime, timezone
 from functools import lru_cache
 from typing import Any, Callable, Iterable
@@ -33,7 +34,8 @@ from typing import Any, Callable, Iterable
 from ..arena import Arena, annulus_arena, default_arena, random_arena, square_arena, two_rooms_arena
 from ..classify import PRESETS, BettiClassifier, load_classifier
 from ..errors import SwarmtopoError
-from ..io import read_arena
+from ..io import GROUND_TRUTH_META_KEYS, read_arena, read_log, write_log
+from ..log import EncounterLog
 from ..persistence import snr
 from ..pipeline import MapConfig, map_encounters, software_versions
 from ..sim import simulate
@@ -78,6 +80,20 @@ def build_arena(arena: dict[str, Any], rng, path: str | None = None) -> Arena:
     return base if scale == 1.0 else base.scaled(scale)
 
 
+def stripped_log(log: EncounterLog) -> EncounterLog:
+    """The log as ``swarmtopo map`` reads it from a folder stripped of ground truth.
+
+    Written to a temporary folder without truth, trajectories, arena or
+    ``GROUND_TRUTH_META_KEYS`` (as :func:`~swarmtopo.io.strip_ground_truth` leaves a
+    folder), and read back with :func:`~swarmtopo.io.read_log`: the map of a sweep sees
+    exactly what a user's ``map`` of such a folder would.
+    """
+    meta = {k: v for k, v in log.meta.items() if k not in GROUND_TRUTH_META_KEYS}
+    with tempfile.TemporaryDirectory(prefix="swarmtopo-log-") as folder:
+        write_log(replace(log, meta=meta), folder, fmt="parquet")
+        return read_log(folder)
+
+
 def run_job(job: Job) -> dict[str, Any]:
     """Simulate and map one job; its row of the store's ``jobs`` table.
 
@@ -108,11 +124,15 @@ def run_job(job: Job) -> dict[str, Any]:
         row["t_simulate"] = time.perf_counter() - t0
         row["n_events"], row["n_agents"] = sim.log.n_events, sim.log.n_agents
         classifier = _classifier(mapping["classifier"], job.file("map.classifier"))
-        landmarks = None if mapping["landmarks"] == "auto" else mapping["landmarks"]
-        map_config = MapConfig(metric=mapping["metric"], subsample=mapping["subsample"], landmarks=landmarks,
-                               max_landmarks=mapping.get("max_landmarks", MapConfig.max_landmarks),
-                               maxdim=mapping["maxdim"], seed=seeds["map"], embed_dim=0, cycles=False)
-        tmap = map_encounters(sim.log, map_config, classifier=classifier)
+        map_config = MapConfig(
+            metric=mapping["metric"], subsample=mapping["subsample"],
+            hop_cost=None if mapping["hop_cost"] == "auto" else mapping["hop_cost"],
+            window_length=None if mapping["window_length"] == "none" else mapping["window_length"],
+            window_step=None if mapping.get("window_step", "auto") == "auto" else mapping["window_step"],
+            landmarks=None if mapping["landmarks"] == "auto" else mapping["landmarks"],
+            max_landmarks=mapping.get("max_landmarks", MapConfig.max_landmarks),
+            maxdim=mapping["maxdim"], seed=seeds["map"], embed_dim=0, cycles=False)
+        tmap = map_encounters(stripped_log(sim.log), map_config, classifier=classifier)
     except SwarmtopoError as exc:
         row["error"] = " ".join(str(exc).split())
     else:
@@ -123,7 +143,9 @@ def run_job(job: Job) -> dict[str, Any]:
             snr_h1=ratio.ratio, noise_power_h1=ratio.noise_power,
             lengths_h1=[float(x) for x in tmap.diagram.lengths(1)],
             diagrams=[{"events": r.n_events, "agents": r.n_agents, "landmarks": len(r.landmarks.nodes),
-                       "diagram": r.diagram.to_json()} for r in tmap.regions],
+                       "diagram": r.diagram.to_json(), "window": r.window,
+                       "windows": [{**w.to_json(), "diagram": w.diagram.to_json()} for w in r.windows]}
+                      for r in tmap.regions],
             n_regions=len(tmap.regions),
             **{column: tmap.timings[stage] for stage, column in _STAGE_COLUMNS.items()},
         )

@@ -1,0 +1,366 @@
+"""The accuracy benchmark: a frozen suite of simulated arenas, split once into tuning
+and reporting seeds.
+
+Suite ``SUITE`` (frozen: changing anything here is a new suite name).  Cells are 0, 1,
+2 and 3 holes x the data budgets ``BUDGETS`` (agents x seconds), plus ``two rooms``
+(two disjoint square rooms, 0-2 holes in all, 300 agents x 40 s).  Within a cell each
+case draws, from its own seed: the family of its holes uniformly from ``HOLE_SHAPES``,
+the outer wall uniformly from ``OUTER_SHAPES`` (square, rectangle, random polygon),
+and the scale uniformly in [0.75, 1.25].
+
+Seed split.  A case is (cell, split, index); its seed is the SHA-256 of
+(``SUITE``, cell, split, index), so tuning and reporting cases never share a seed and
+adding cases never changes old ones.  The shape family ``HELD_OUT_FAMILY`` is left
+out of tuning entirely (tuning arenas draw their holes from the other four
+families) and reporting cases that contain it are reported on their own line.
+Tuning code runs inside :func:`tuning_session`, in which :func:`reporting_jobs`
+refuses to run: defaults cannot be chosen by looking at the reported table.
+
+Every case becomes a sweep :class:`~.grid.Job` per pipeline (``PIPELINES``: the
+default and the paper's best), so the benchmark runs on Dask with a resumable DuckDB
+store like any sweep, and each job maps a log folder stripped of ground truth
+(:func:`~.sweep.stripped_log`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from contextlib import contextmanager
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Any
+
+import numpy as np
+
+from ..arena import HOLE_SHAPES, OUTER_SHAPES
+from ..cycles import wilson_interval
+from ..errors import SwarmtopoError
+from ..persistence import Diagram
+from ..ratio import WindowBars, vote
+from ..pipeline import MapConfig
+from .grid import Job, canonical_json, case_streams
+from .sweep import build_arena
+
+SUITE = "swarmtopo-accuracy/1"
+BUDGETS: tuple[tuple[int, float], ...] = ((200, 30.0), (300, 40.0), (400, 60.0))
+"""Data budgets (agents N, duration T in seconds) of the hole-count cells."""
+TWO_ROOMS_BUDGET = (300, 40.0)
+HELD_OUT_FAMILY = "L"
+"""Hole family never seen by tuning; reported on its own line."""
+SCALE_RANGE = (0.75, 1.25)
+ROOM_SIDE = 500.0
+"""Side (mm, before scaling) of the generators' square of equal area (their default)."""
+MAX_ATTEMPTS = 20
+REPORTING_PER_CELL = 30
+QUICK_PER_CELL = 10
+TUNING_PER_CELL = 12
+
+PIPELINES: dict[str, dict[str, Any]] = {
+    "default": {"metric": "hybrid", "hop_cost": "auto", "window_length": MapConfig.window_length, "window_step": "auto",
+                "classifier": "default"},
+    "paper": {"metric": "hybrid", "hop_cost": 0.0, "window_length": "none", "classifier": "paper-form"},
+}
+"""The pipelines the benchmark compares: swarmtopo's default, and the best
+configuration of the paper's own methods (its metric and subsampler, whole log, its
+classifier form trained our way: the ``paper-form`` preset)."""
+
+
+@dataclass(frozen=True)
+class Cell:
+    """One row of the table: a hole count (None: two rooms with 0-2 holes) and a budget."""
+
+    name: str
+    generator: str
+    holes: int | None
+    agents: int
+    duration: float
+
+
+CELLS: tuple[Cell, ...] = (
+    *(Cell(f"{h} holes, {n} x {t:g} s", "random", h, n, t) for h in range(4) for n, t in BUDGETS),
+    Cell(f"two rooms, {TWO_ROOMS_BUDGET[0]} x {TWO_ROOMS_BUDGET[1]:g} s", "two_rooms", None, *TWO_ROOMS_BUDGET),
+)
+
+_session = {"tuning": False}
+
+
+@contextmanager
+def tuning_session():
+    """Mark the code inside as tuning: :func:`reporting_jobs` raises there."""
+    previous = _session["tuning"]
+    _session["tuning"] = True
+    try:
+        yield
+    finally:
+        _session["tuning"] = previous
+
+
+def case_seed(cell: Cell, split: str, index: int, attempt: int = 0) -> int:
+    """64-bit seed of one case, from (SUITE, cell, split, index, attempt)."""
+    identity = {"suite": SUITE, "cell": cell.name, "split": split, "index": index}
+    text = canonical_json(identity if attempt == 0 else {**identity, "attempt": attempt})
+    return int.from_bytes(hashlib.sha256(text.encode()).digest()[:8], "big")
+
+
+def case_arena(cell: Cell, split: str, index: int, attempt: int = 0) -> dict[str, Any]:
+    """The ``[arena]`` table of one case: generator, holes, families, outer wall, scale."""
+    rng = np.random.default_rng(case_seed(cell, split, index, attempt))
+    families = [s for s in HOLE_SHAPES if split == "reporting" or s != HELD_OUT_FAMILY]
+    holes = int(rng.integers(0, 3)) if cell.holes is None else cell.holes
+    shapes = [families[int(rng.integers(len(families)))]]  # one family for all the case's holes
+    scale = float(np.round(rng.uniform(*SCALE_RANGE), 4))
+    arena: dict[str, Any] = {"generator": cell.generator, "holes": holes, "shapes": shapes, "scale": scale}
+    if cell.generator == "random":
+        arena["outer"] = OUTER_SHAPES[int(rng.integers(len(OUTER_SHAPES)))]
+    return arena
+
+
+@lru_cache(maxsize=None)
+def case(cell: Cell, split: str, index: int) -> tuple[dict[str, Any], int]:
+    """(arena table, case seed) of a case whose holes fit.
+
+    Some draws cannot hold their holes (three walls in a narrow rectangle); such a
+    draw is replaced by the next attempt's, decided once by building the arena, so
+    every case of the suite is a valid arena.  Cached: building arenas is the slow part.
+    """
+    for attempt in range(MAX_ATTEMPTS):
+        arena = case_arena(cell, split, index, attempt)
+        seed = case_seed(cell, split, index, attempt)
+        try:
+            build_arena(arena, case_streams(seed)["arena"])
+        except SwarmtopoError:
+            continue
+        return arena, seed
+    raise SwarmtopoError(f"{SUITE}: no placeable arena for {cell.name} case {index} in {MAX_ATTEMPTS} attempts")
+
+
+def _jobs(split: str, per_cell: int, pipelines: dict[str, dict[str, Any]], cells=CELLS) -> list[Job]:
+    jobs = []
+    for cell, index in ((cell, index) for cell in cells for index in range(per_cell)):
+        arena, seed = case(cell, split, index)
+        for name, mapping in pipelines.items():
+            config = {"arena": arena, "swarm": {"agents": cell.agents, "duration": cell.duration,
+                                                 "static_fraction": 0.0},
+                      "map": {"subsample": "maxmin", "landmarks": "auto", "max_landmarks": MapConfig.max_landmarks,
+                              "maxdim": 1, **mapping}}
+            jobs.append(Job(sweep=f"accuracy-{split}-{name}", config_json=canonical_json(config),
+                            replicate=index, salt=f"{SUITE}/{split}/{cell.name}", case_seed=seed))
+    return jobs
+
+
+def tuning_jobs(pipelines: dict[str, dict[str, Any]], per_cell: int = TUNING_PER_CELL, cells=CELLS) -> list[Job]:
+    """Jobs of the tuning cases (never the held-out family) under candidate pipelines."""
+    return _jobs("tuning", per_cell, pipelines, cells)
+
+
+def reporting_jobs(per_cell: int = REPORTING_PER_CELL, pipelines=None, cells=CELLS) -> list[Job]:
+    """Jobs of the reporting cases; refused inside a :func:`tuning_session`."""
+    if _session["tuning"]:
+        raise SwarmtopoError("the benchmark's reporting seeds are closed to tuning code (inside tuning_session)")
+    return _jobs("reporting", per_cell, pipelines or PIPELINES, cells)
+
+
+def has_held_out_family(config: dict[str, Any]) -> bool:
+    """Whether a case's arena has holes of ``HELD_OUT_FAMILY``."""
+    arena = config["arena"]
+    return arena.get("holes", 0) > 0 and HELD_OUT_FAMILY in arena.get("shapes", ())
+
+
+def cell_of(config: dict[str, Any]) -> str:
+    """The cell name of a job's config."""
+    arena, swarm = config["arena"], config["swarm"]
+    for cell in CELLS:
+        if (cell.generator == arena["generator"] and cell.agents == swarm["agents"]
+                and cell.duration == swarm["duration"] and cell.holes in (None, arena.get("holes"))):
+            return cell.name
+    raise SwarmtopoError(f"not a case of {SUITE}: {json.dumps(config)}")
+
+
+# -- the table ----------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Rate:
+    """k right out of n, with its Wilson 95 % interval."""
+
+    right: int
+    total: int
+
+    @property
+    def rate(self) -> float:
+        return self.right / self.total if self.total else float("nan")
+
+    @property
+    def interval(self) -> tuple[float, float]:
+        return wilson_interval(self.right, self.total)
+
+    def to_json(self) -> dict[str, Any]:
+        """``{"right", "total", "rate", "wilson95"}``; rate and interval null for no maps."""
+        if not self.total:
+            return {"right": 0, "total": 0, "rate": None, "wilson95": None}
+        return {"right": self.right, "total": self.total, "rate": self.rate, "wilson95": list(self.interval)}
+
+
+def outcomes(rows, classifier) -> list[dict[str, Any]]:
+    """One record per reporting row: cell, held-out family, truth, estimate,
+    confidences, and whether (beta_0, beta_1) is exactly right.
+
+    beta_1 and its confidence are read from the row's stored per-window diagrams by
+    ``classifier`` (each region's windows voted as in the pipeline), so the table is
+    the given classifier's verdict on the stored maps: the shipped one's, whatever
+    classifier ran the job.  beta_0 is the job's (graph components).  A failed job
+    (too little data to map) counts as wrong.
+    """
+    records = []
+    for row in rows:
+        config = row["config"]
+        est0, est1, conf0, conf1 = row["est_betti0"], None, None, None
+        if row["error"] is None:
+            regions = [[WindowBars(Diagram.from_json(w["diagram"]), float(w["cover_radius"])) for w in r["windows"]]
+                       for r in row["diagrams"]]
+            est1 = sum(vote(classifier, windows)[0].get(1, 0) for windows in regions)
+            confs = [classifier.region_confidence(windows).get(1) for windows in regions]
+            conf1 = None if None in confs else float(np.prod(confs))
+            conf0 = classifier.beta0_confidence()
+        right = row["error"] is None and est0 == row["true_betti0"] and est1 == row["true_betti1"]
+        records.append({
+            "cell": cell_of(config), "held_out": has_held_out_family(config),
+            "agents": config["swarm"]["agents"], "duration": config["swarm"]["duration"],
+            "area": case_area(config), "true_betti0": row["true_betti0"], "true_betti1": row["true_betti1"],
+            "est_betti0": est0, "est_betti1": est1, "confidence_betti0": conf0, "confidence_betti1": conf1,
+            "right": bool(right), "betti0_right": row["error"] is None and est0 == row["true_betti0"],
+            "betti1_right": row["error"] is None and est1 == row["true_betti1"], "error": row["error"],
+            "seconds": row["t_total"],
+        })
+    return records
+
+
+def accuracy_table(records: list[dict[str, Any]]) -> dict[str, Any]:
+    """Exact-match rates: overall, per cell, the held-out family, and the rest."""
+    def rate(subset):
+        return Rate(sum(r["right"] for r in subset), len(subset))
+
+    return {
+        "overall": rate(records),
+        "cells": {cell.name: rate([r for r in records if r["cell"] == cell.name]) for cell in CELLS},
+        "held_out": rate([r for r in records if r["held_out"]]),
+        "seen_families": rate([r for r in records if not r["held_out"]]),
+    }
+
+
+def reliability(records: list[dict[str, Any]], n: int, bins: int = 5) -> dict[str, Any]:
+    """Calibration of the beta_n confidence: per confidence bin, the mean confidence
+    and the fraction right; the Brier score against a constant equal to the accuracy."""
+    pairs = [(r[f"confidence_betti{n}"], r[f"betti{n}_right"]) for r in records
+             if r[f"confidence_betti{n}"] is not None]
+    if not pairs:
+        return {"bins": [], "brier": None, "brier_constant": None, "maps": 0}
+    p = np.array([c for c, _ in pairs], dtype=float)
+    y = np.array([ok for _, ok in pairs], dtype=float)
+    edges = np.linspace(0.0, 1.0, bins + 1)
+    which = np.clip(np.digitize(p, edges[1:-1]), 0, bins - 1)
+    table = []
+    for b in range(bins):
+        inside = which == b
+        if inside.any():
+            table.append({"low": float(edges[b]), "high": float(edges[b + 1]), "maps": int(inside.sum()),
+                          "mean_confidence": float(p[inside].mean()), "fraction_right": float(y[inside].mean()),
+                          "wilson95": list(wilson_interval(int(y[inside].sum()), int(inside.sum())))})
+    return {"bins": table, "brier": float(np.mean((p - y) ** 2)),
+            "brier_constant": float(np.mean((y.mean() - y) ** 2)), "maps": int(len(y))}
+
+
+def case_area(config: dict[str, Any]) -> float:
+    """Area (mm^2) inside the outer walls of a case: every outer wall of the suite has
+    area (500 scale)^2, and two rooms twice that."""
+    arena = config["arena"]
+    room = (ROOM_SIDE * arena["scale"]) ** 2
+    return 2 * room if arena["generator"] == "two_rooms" else room
+
+
+def run_benchmark(store, *, quick: bool = False, scheduler: str | None = None, workers: int | None = None,
+                  progress=None, per_cell: int | None = None, cells=CELLS) -> dict[str, Any]:
+    """Run (or resume) the reporting cases of every pipeline; the summary document.
+
+    Returns ``{"suite", "cases_per_cell", "seconds", "jobs_per_minute", "pipelines":
+    {name: {"table", "reliability"}}, "records"}`` with tables as from
+    :func:`accuracy_table` (``Rate`` objects as JSON) and the records of the default
+    pipeline (what ``plan`` is fitted on).  Each pipeline's maps are read by its
+    shipped classifier (:func:`outcomes`); ``paper-theta`` is the paper pipeline's
+    maps read by the paper's published Theta*.
+    """
+    from ..classify import load_classifier
+    from .store import read_jobs
+    from .sweep import run_sweep
+
+    per_cell = per_cell or (QUICK_PER_CELL if quick else REPORTING_PER_CELL)
+    jobs = reporting_jobs(per_cell, cells=cells)
+    summary = run_sweep(jobs, store, scheduler=scheduler, workers=workers, progress=progress)
+    keys = {job.key for job in jobs}
+    rows = [row for row in read_jobs(store) if row["key"] in keys]
+    by_pipeline = {name: [r for r in rows if _pipeline_of(r["config"]) == name] for name in PIPELINES}
+    results = {name: outcomes(subset, load_classifier(PIPELINES[name]["classifier"]))
+               for name, subset in by_pipeline.items()}
+    results["paper-theta"] = outcomes(by_pipeline["paper"], load_classifier("paper"))
+    return {
+        "suite": SUITE, "cases_per_cell": per_cell, "maps": len(rows),
+        "seconds": summary.seconds, "jobs_run": summary.run, "workers": summary.workers,
+        "pipelines": {name: {"table": {k: (v.to_json() if isinstance(v, Rate) else {c: r.to_json() for c, r in v.items()})
+                                       for k, v in accuracy_table(recs).items()},
+                             "reliability": {str(n): reliability(recs, n) for n in (0, 1)},
+                             "mean_seconds": float(np.mean([r["seconds"] for r in recs])) if recs else None}
+                      for name, recs in results.items()},
+        "records": results["default"],
+    }
+
+
+def _pipeline_of(config: dict[str, Any]) -> str | None:
+    for name, mapping in PIPELINES.items():
+        if all(config["map"].get(k) == v for k, v in mapping.items()):
+            return name
+    return None
+
+
+PIPELINE_LABELS = {"default": "swarmtopo default", "paper": "paper's methods, trained our way",
+                   "paper-theta": "paper's methods, paper's Theta*"}
+
+
+def markdown(summary: dict[str, Any], command: str) -> str:
+    """The benchmark's tables as Markdown (what docs/accuracy.md quotes)."""
+    names = list(summary["pipelines"])
+
+    def cell(rate: dict[str, Any]) -> str:
+        if not rate["total"]:
+            return "-"
+        lo, hi = rate["wilson95"]
+        return f"{rate['right']}/{rate['total']} = {rate['rate']:.2f} [{lo:.2f}, {hi:.2f}]"
+
+    lines = [f"Suite `{summary['suite']}`, {summary['cases_per_cell']} reporting cases per cell, "
+             f"{summary['maps']} maps. Command: `{command}`; {summary['jobs_run']} jobs run in "
+             f"{summary['seconds'] / 60:.1f} min on {summary['workers']} Dask workers.", "",
+             "Exact (beta_0, beta_1), k/n = rate [Wilson 95 %]:", "",
+             "| cell | " + " | ".join(PIPELINE_LABELS.get(n, n) for n in names) + " |",
+             "|---|" + "---|" * len(names)]
+    for c in CELLS:
+        lines.append(f"| {c.name} | " + " | ".join(cell(summary["pipelines"][n]["table"]["cells"][c.name])
+                                                for n in names) + " |")
+    for key, label in (("overall", "**all reporting cases**"), ("seen_families", "families seen in tuning"),
+                       (None, None), ("held_out", f"held-out family ({HELD_OUT_FAMILY}-shaped holes)")):
+        if key is None:
+            continue
+        lines.append(f"| {label} | " + " | ".join(cell(summary["pipelines"][n]["table"][key]) for n in names) + " |")
+    lines.append("| mean seconds per map | " + " | ".join(
+        f"{summary['pipelines'][n]['mean_seconds']:.2f}" if summary["pipelines"][n]["mean_seconds"] else "-"
+        for n in names) + " |")
+    for n_dim in ("1", "0"):
+        rel = summary["pipelines"]["default"]["reliability"][n_dim]
+        if not rel["maps"]:
+            continue
+        lines += ["", f"Reliability of the default pipeline's beta_{n_dim} confidence ({rel['maps']} maps): "
+                      f"Brier score {rel['brier']:.4f} against {rel['brier_constant']:.4f} for a constant "
+                      "confidence equal to the accuracy.", "",
+                  "| confidence | maps | mean confidence | fraction right [Wilson 95 %] |", "|---|---|---|---|"]
+        for b in rel["bins"]:
+            lo, hi = b["wilson95"]
+            lines.append(f"| {b['low']:.1f}-{b['high']:.1f} | {b['maps']} | {b['mean_confidence']:.2f} | "
+                         f"{b['fraction_right']:.2f} [{lo:.2f}, {hi:.2f}] |")
+    return "\n".join(lines) + "\n"
