@@ -36,15 +36,14 @@ def one_map(n_holes: int, seed: int, duration: float):
     arena = random_arena(n_holes, rng=seed, shapes=("square", "disc"))
     sim = simulate(arena, 200, duration, rng=seed, truth=True)
     t0 = time.perf_counter()
-    tmap = map_encounters(sim.log, MapConfig(seed=seed, embed_dim=0))
+    tmap = map_encounters(sim.log, MapConfig(seed=seed, embed_dim=0, cycles=False))
     t1 = time.perf_counter()
     found = {p: [] for p in POSITIONS}
     for region in tmap.regions:
         distances = region.landmarks.distances
         result = rips_persistence(distances, maxdim=1, cocycles=True)
         for position in POSITIONS:
-            for cycle in representative_cycles(distances, result, threshold=region.thresholds[1],
-                                               position=position):
+            for cycle in representative_cycles(distances, result, region.counted[1], position=position):
                 xy = event_positions(sim.truth, region.landmark_events[cycle.landmarks])
                 found[position].append((cycle, xy, encircled_obstacles(xy, arena)))
     t2 = time.perf_counter()

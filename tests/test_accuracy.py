@@ -80,12 +80,9 @@ def recorded_slice() -> tuple[int, int]:
     return int(match.group(1)), int(match.group(2))
 
 
-SLICE_PER_CELL = 2
-
-
 @pytest.mark.slow
 def test_regression_slice_keeps_its_recorded_accuracy_and_calibration():
-    """The first SLICE_PER_CELL reporting cases of every cell, default pipeline.
+    """The first acc.SLICE_PER_CELL reporting cases of every cell, default pipeline.
 
     Margin: with the recorded rate p over n maps, a pipeline as good as recorded falls
     below the 1 % binomial quantile Bin(n, p) in 1 % of runs; the maps are seeded, so on
@@ -93,7 +90,7 @@ def test_regression_slice_keeps_its_recorded_accuracy_and_calibration():
     confidence and the fraction right over n = 26 maps agree within 0.15 (about 2.5
     standard deviations of a fraction near 0.9).
     """
-    jobs = acc.reporting_jobs(per_cell=SLICE_PER_CELL, pipelines={"default": acc.PIPELINES["default"]})
+    jobs = acc.reporting_jobs(per_cell=acc.SLICE_PER_CELL, pipelines={"default": acc.PIPELINES["default"]})
     records = acc.outcomes([run_job(job) for job in jobs], load_classifier("default"))
     right = sum(r["right"] for r in records)
     k, n = recorded_slice()

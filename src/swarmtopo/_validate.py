@@ -55,6 +55,15 @@ def non_negative_int(name: str, value) -> int:
     return n
 
 
+def check_format(obj, expected: str, what: str, source: str) -> dict:
+    """``obj`` if it is a JSON object whose ``format`` is ``expected``; else an
+    InputError naming ``source`` and the format found."""
+    if not isinstance(obj, dict) or obj.get("format") != expected:
+        raise InputError(f"not a {what} (expected \"format\": \"{expected}\")", file=source, column="format",
+                         value=obj.get("format") if isinstance(obj, dict) else obj)
+    return obj
+
+
 def _real(name: str, value, allow_inf: bool) -> float:
     """float(value) for a real number (NaN and, unless allowed, inf included: the
     callers' range checks refuse them with their own message)."""

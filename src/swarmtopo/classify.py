@@ -53,6 +53,7 @@ from sklearn.base import BaseEstimator
 from sklearn.linear_model import LogisticRegression
 
 from . import __version__
+from ._validate import check_format
 from .errors import InputError, SwarmtopoError
 from .persistence import Diagram
 
@@ -259,11 +260,12 @@ class BettiClassifier(BaseEstimator):
         """Same as :meth:`thresholds` (the interface shared with the ratio classifier)."""
         return self.thresholds(diagram)
 
-    def region_confidence(self, windows) -> dict[int, float | None]:
-        """Confidence of a region mapped in windows: that of its representative window."""
+    def region_confidence(self, windows, voted=None) -> dict[int, float | None]:
+        """Confidence of a region mapped in windows: that of its representative window
+        (``voted``: :func:`swarmtopo.ratio.vote`'s result, when the caller has it)."""
         from .ratio import vote
 
-        _, rep, _ = vote(self, windows)
+        _, rep, _ = voted or vote(self, windows)
         return self.confidence(windows[rep].diagram)
 
     def confidence(self, diagram: Diagram) -> dict[int, float | None]:
@@ -320,9 +322,7 @@ class BettiClassifier(BaseEstimator):
 
     @classmethod
     def from_json(cls, obj: dict, source: str = "<json>") -> "BettiClassifier":
-        if not isinstance(obj, dict) or obj.get("format") != CLASSIFIER_FORMAT:
-            raise InputError(f"not a swarmtopo classifier (expected \"format\": \"{CLASSIFIER_FORMAT}\")",
-                             file=source, column="format", value=obj.get("format") if isinstance(obj, dict) else obj)
+        check_format(obj, CLASSIFIER_FORMAT, "swarmtopo classifier", source)
         try:
             params = obj["params"]
             model = cls(dims=tuple(int(n) for n in params["dims"]), optimizer=params["optimizer"])

@@ -266,7 +266,8 @@ def demo(
     if verbose:
         _detail(f"simulated: {sim.log.n_events} encounters of {DEMO_AGENTS} agents over {DEMO_SECONDS:g} s; "
                 f"log: {log_dir}")
-    tmap, written = _run_map(sim.log, MapConfig(seed=seed), log_dir, out_dir, quiet, verbose)
+    tmap, written = _run_map(sim.log, MapConfig(seed=seed), log_dir, out_dir, quiet, verbose,
+                             ground_truth=(world, sim.truth, sim.trajectories))
     if not quiet:
         _print_verdict(tmap, truth=world.betti)
         out.print(f"log: {log_dir}")
@@ -476,9 +477,11 @@ def _plan_answer(what: str, value: float, condition: str) -> str:
     return f"needed: {math.ceil(value)} {what} {condition}"
 
 
-def _run_map(log, config, log_dir: Path, out_dir: Path, quiet: bool, verbose: bool = False, classifier=None):
+def _run_map(log, config, log_dir: Path, out_dir: Path, quiet: bool, verbose: bool = False, classifier=None,
+             ground_truth=None):
     """Map, write map.json and figures; ground truth beside the log only colours pictures,
-    and a broken ground-truth file costs a warning, never the map."""
+    and a broken ground-truth file costs a warning, never the map.  ``ground_truth``
+    (arena, truth, trajectories): the caller's, instead of reading them beside the log."""
     from .pipeline import STAGES, map_encounters
     from .report import write_map_outputs
 
@@ -488,7 +491,7 @@ def _run_map(log, config, log_dir: Path, out_dir: Path, quiet: bool, verbose: bo
         tick(1.0)
     if verbose:
         _map_details(tmap)
-    arena, truth, trajectories = _ground_truth(log, log_dir, quiet)
+    arena, truth, trajectories = ground_truth or _ground_truth(log, log_dir, quiet)
     return tmap, write_map_outputs(tmap, out_dir, log=log, truth=truth, arena=arena, trajectories=trajectories)
 
 

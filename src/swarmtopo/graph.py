@@ -87,6 +87,7 @@ import scipy.sparse as sp
 from numba import njit
 from scipy.sparse.csgraph import connected_components, csgraph_from_dense, dijkstra
 
+from ._validate import non_negative
 from .errors import InputError
 from .log import EncounterLog
 
@@ -237,7 +238,7 @@ def build_graph(log: EncounterLog, metric: str = "plain", *,
     intervals = _stop_intervals(log, metric)
     if intervals is not None and len(intervals[0]):
         weight[_within_one_interval(pair_agent, t[first], t[second], intervals, log.n_agents)] = 0.0
-    weight += _check_hop_cost(hop_cost)
+    weight += non_negative("hop cost", hop_cost)
     event_index = np.arange(start, stop, dtype=np.int64)
     return _contract(t, first, second, weight, event_index, metric)
 
@@ -283,16 +284,6 @@ def literal_distances(log: EncounterLog, metric: str,
 
 
 # -- construction steps ----------------------------------------------------------------
-def _check_hop_cost(hop_cost) -> float:
-    try:
-        h = float(hop_cost)
-    except (TypeError, ValueError):
-        h = float("nan")
-    if not (np.isfinite(h) and h >= 0.0):
-        raise InputError("hop cost must be a finite number of seconds >= 0", column="hop_cost", value=hop_cost)
-    return h
-
-
 def _check_metric(metric) -> None:
     if metric not in METRICS:
         raise InputError(f"unknown encounter metric; expected one of {', '.join(METRICS)}",

@@ -67,7 +67,7 @@ class MapConfig:
         hybrid = contracted + static agents as unbounded stops; it falls back to
         contracted without static agents and to plain without status).
     hop_cost
-        Per-hop cost h (seconds) added to every positive chain edge of the graph
+        Per-hop cost h (seconds) added to every chain edge of the graph
         (:mod:`swarmtopo.graph`); 0 is the paper's metric; None (default) takes
         r_d / v_c from the log's meta.json, or, for a trace without them,
         ``HOP_GAP_FACTOR`` x the mean time between an agent's encounters.
@@ -350,27 +350,33 @@ def map_encounters(
     shares = (_share_landmarks(config.landmarks, events_per_comp[regions_idx]) if config.landmarks
               else [None] * len(regions_idx))
     spans = _windows(graph.event_t, config.window_length, config.window_step)
-    # a window with fewer events than a region needs (a gap in a real trace) is skipped
-    window_graphs = ([(None, graph, labels)] if len(spans) == 1 else
-                     [(span, *_with_components(build_graph(log, config.metric, window=span, hop_cost=hop_cost)))
-                      for span in spans if _events_within(log, span) >= config.min_region_events])
+    window_graphs = [(None, graph, labels)]  # (span, graph, component labels) of each window
+    if len(spans) > 1:
+        window_graphs = []
+        for span in spans:
+            if _events_within(log, span) >= config.min_region_events:  # a gap in a real trace is skipped
+                wgraph = build_graph(log, config.metric, window=span, hop_cost=hop_cost)
+                window_graphs.append((span, wgraph, wgraph.components()[1]))
     regions: list[RegionMap] = []
     for comp, n_land in zip(regions_idx, shares):
         region_events = graph.event_index[event_comp == comp]
-        windows = [w for span, wgraph, wlabels in window_graphs
-                   if (w := _map_window(span, _region_part(wgraph, wlabels, region_events, log, config),
-                                        n_land, config, rng, timings, say)) is not None]
+        windows = []
+        for span, wgraph, wlabels in window_graphs:
+            part = _region_part(wgraph, wlabels, region_events, log, config)
+            if part is not None:
+                windows.append(_map_window(span, part, n_land, config, rng, timings, say))
         if not windows:  # no window holds enough of this region: map its whole log instead
             whole = graph.subgraph(np.flatnonzero(labels == comp))
             windows = [_map_window(None, whole, n_land, config, rng, timings, say)]
         say("classify")
         t0 = time.perf_counter()
         bars = [WindowBars(w.diagram, w.scales.cover_radius) for w in windows]
-        betti_region, rep, counts = vote(classifier, bars)
+        voted = vote(classifier, bars)
+        betti_region, rep, counts = voted
         for w, *window_counts in zip(windows, *counts.values()):
             w.betti = dict(zip(counts, window_counts))
         chosen = windows[rep]
-        confidence_region = classifier.region_confidence(bars)
+        confidence_region = classifier.region_confidence(bars, voted)
         counted = classifier.counted(chosen.diagram, chosen.scales.cover_radius)
         thresholds = classifier.length_thresholds(chosen.diagram, chosen.scales.cover_radius)
         timings["classify"] += time.perf_counter() - t0
@@ -429,11 +435,9 @@ def map_encounters(
     )
 
 
-def _map_window(span, sub: EncounterGraph | None, n_land: int | None, config: MapConfig, rng,
-                timings: dict[str, float], say) -> "WindowMap | None":
-    """Landmarks and persistence of one region's events in one time window (None: too few)."""
-    if sub is None:
-        return None
+def _map_window(span, sub: EncounterGraph, n_land: int | None, config: MapConfig, rng,
+                timings: dict[str, float], say) -> WindowMap:
+    """Landmarks and persistence of one region's events in one time window (span None: all)."""
     say("landmarks")
     t0 = time.perf_counter()
     knn_scale = _knn_scale(sub, config.knn_k)
@@ -485,10 +489,6 @@ def _windows(event_t: np.ndarray, length: float | None, step: float | None = Non
 
 def _events_within(log: EncounterLog, span: tuple[float, float]) -> int:
     return int(np.searchsorted(log.t, span[1], side="right") - np.searchsorted(log.t, span[0], side="left"))
-
-
-def _with_components(graph: EncounterGraph) -> tuple[EncounterGraph, np.ndarray]:
-    return graph, graph.components()[1]
 
 
 def _region_part(graph: EncounterGraph, labels: np.ndarray, region_events: np.ndarray, log: EncounterLog,

@@ -26,6 +26,7 @@ import numpy as np
 from scipy.special import expit, logit
 from sklearn.linear_model import LogisticRegression
 
+from ._validate import check_format, positive
 from .errors import InputError, SwarmtopoError
 
 PLAN_FORMAT = "swarmtopo-plan/1"
@@ -78,8 +79,7 @@ class PlanModel:
 
     @classmethod
     def from_json(cls, obj: dict, source: str = "<json>") -> "PlanModel":
-        if not isinstance(obj, dict) or obj.get("format") != PLAN_FORMAT:
-            raise InputError(f"not a swarmtopo plan model (expected \"format\": \"{PLAN_FORMAT}\")", file=source)
+        check_format(obj, PLAN_FORMAT, "swarmtopo plan model", source)
         try:
             return cls(float(obj["intercept"]), float(obj["density_coef"]), float(obj["duration_coef"]),
                        tuple(map(float, obj["density_range"])), tuple(map(float, obj["duration_range"])),
@@ -121,5 +121,4 @@ def _target(target: float) -> float:
 
 def _check_positive(**values: float) -> None:
     for name, value in values.items():
-        if not (np.isfinite(value) and value > 0):
-            raise InputError(f"{name} must be a positive number", column=name, value=value)
+        positive(name, value)

@@ -43,6 +43,7 @@ from scipy.special import expit
 from sklearn.linear_model import LogisticRegression
 
 from . import __version__
+from ._validate import check_format
 from .errors import InputError, SwarmtopoError
 from .persistence import Diagram
 
@@ -193,15 +194,18 @@ class RatioClassifier:
         return window_margin(diagram, n, cover_radius, self.thresholds_[n])
 
     # -- a region: several windows --------------------------------------------------------
-    def region_features(self, windows: Sequence[WindowBars], n: int) -> np.ndarray:
-        """(agreement a, margin m, number of windows) of one region for dimension n."""
-        betti, rep, counts = vote(self, windows)
+    def region_features(self, windows: Sequence[WindowBars], n: int, voted=None) -> np.ndarray:
+        """(agreement a, margin m, number of windows) of one region for dimension n;
+        ``voted`` is :func:`vote`'s result for these windows when the caller has it."""
+        betti, rep, counts = voted or vote(self, windows)
         agreement = float(np.mean(np.asarray(counts[n]) == betti[n]))
         margin = window_margin(windows[rep].diagram, n, windows[rep].cover_radius, self.thresholds_[n])
         return np.array([agreement, margin, float(len(windows))])
 
-    def region_confidence(self, windows: Sequence[WindowBars]) -> dict[int, float | None]:
-        """P(the region's beta_hat_n is right) from the calibrated model; None if uncalibrated."""
+    def region_confidence(self, windows: Sequence[WindowBars], voted=None) -> dict[int, float | None]:
+        """P(the region's beta_hat_n is right) from the calibrated model; None if uncalibrated.
+        ``voted``: :func:`vote`'s result for these windows, when the caller has it."""
+        voted = voted or vote(self, windows)
         out: dict[int, float | None] = {}
         for n in self.thresholds_:
             if n > windows[0].diagram.maxdim:
@@ -210,7 +214,7 @@ class RatioClassifier:
             if model is None:
                 out[n] = None
                 continue
-            a, m, k = self.region_features(windows, n)
+            a, m, k = self.region_features(windows, n, voted)
             out[n] = float(expit(model["intercept"] + model["agreement"] * a + model["margin"] * m
                                  + model["windows"] * np.log(k)))
         return out
@@ -277,9 +281,7 @@ class RatioClassifier:
 
     @classmethod
     def from_json(cls, obj: dict, source: str = "<json>") -> "RatioClassifier":
-        if not isinstance(obj, dict) or obj.get("format") != RATIO_FORMAT:
-            raise InputError(f"not a swarmtopo ratio classifier (expected \"format\": \"{RATIO_FORMAT}\")",
-                             file=source, column="format", value=obj.get("format") if isinstance(obj, dict) else obj)
+        check_format(obj, RATIO_FORMAT, "swarmtopo ratio classifier", source)
         try:
             thresholds = {int(n): RatioThresholds(float(t["q"]), float(t["tau"]), float(t["rho"]), float(t["kappa"]))
                           for n, t in obj["thresholds"].items()}

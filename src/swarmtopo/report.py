@@ -26,8 +26,9 @@ def write_map_outputs(tmap: TopologicalMap, out_dir: Path, *, log: EncounterLog,
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     written = [out_dir / "map.json", out_dir / "report.html", out_dir / "diagram.png"]
-    write_json(tmap.to_json(), written[0])
-    write_report(tmap, written[1], log=log, truth=truth, arena=arena, trajectories=trajectories)
+    doc = tmap.to_json()  # one document for map.json and the report: they cannot disagree
+    write_json(doc, written[0])
+    write_report(tmap, written[1], log=log, truth=truth, arena=arena, trajectories=trajectories, doc=doc)
     _diagram_figure(tmap).savefig(written[2], dpi=110)
     if any(r.embedding is not None for r in tmap.regions):
         written.append(out_dir / "cloud.png")

@@ -60,16 +60,16 @@ code{background:#f5f5f5;padding:0 .2em}
 
 
 def write_report(tmap: TopologicalMap, path, *, log: EncounterLog, truth: dict | None = None, arena=None,
-                 trajectories: dict | None = None) -> Path:
+                 trajectories: dict | None = None, doc: dict | None = None) -> Path:
     """Write :func:`report_html` to ``path`` (UTF-8) and return the path."""
     path = Path(path)
-    path.write_text(report_html(tmap, log=log, truth=truth, arena=arena, trajectories=trajectories),
+    path.write_text(report_html(tmap, log=log, truth=truth, arena=arena, trajectories=trajectories, doc=doc),
                     encoding="utf-8")
     return path
 
 
 def report_html(tmap: TopologicalMap, *, log: EncounterLog, truth: dict | None = None, arena=None,
-                trajectories: dict | None = None) -> str:
+                trajectories: dict | None = None, doc: dict | None = None) -> str:
     """The report as one HTML document (see the module docstring).
 
     Parameters
@@ -85,10 +85,12 @@ def report_html(tmap: TopologicalMap, *, log: EncounterLog, truth: dict | None =
         The true arena: true Betti numbers in the verdict, arena in the pictures.
     trajectories
         Sampled true positions (``io.read_trajectories``): the swarm animation.
+    doc
+        ``tmap.to_json()`` when the caller already has it (the map.json it writes).
     """
     from plotly.offline import get_plotlyjs
 
-    doc = tmap.to_json()
+    doc = doc or tmap.to_json()
     figures: dict[str, dict] = {}
     sections = [
         _verdict_section(doc, arena),

@@ -54,6 +54,9 @@ ROOM_SIDE = 500.0
 MAX_ATTEMPTS = 20
 REPORTING_PER_CELL = 30
 QUICK_PER_CELL = 10
+SLICE_PER_CELL = 2
+"""The regression slice: the first SLICE_PER_CELL reporting cases of every cell
+(default pipeline), rerun by tests/test_accuracy.py against the rate recorded here."""
 TUNING_PER_CELL = 12
 
 PIPELINES: dict[str, dict[str, Any]] = {
@@ -217,13 +220,14 @@ def outcomes(rows, classifier) -> list[dict[str, Any]]:
         if row["error"] is None:
             regions = [[WindowBars(Diagram.from_json(w["diagram"]), float(w["cover_radius"])) for w in r["windows"]]
                        for r in row["diagrams"]]
-            est1 = sum(vote(classifier, windows)[0].get(1, 0) for windows in regions)
-            confs = [classifier.region_confidence(windows).get(1) for windows in regions]
+            votes = [vote(classifier, windows) for windows in regions]
+            est1 = sum(voted[0].get(1, 0) for voted in votes)
+            confs = [classifier.region_confidence(windows, voted).get(1) for windows, voted in zip(regions, votes)]
             conf1 = None if None in confs else float(np.prod(confs))
             conf0 = classifier.beta0_confidence()
         right = row["error"] is None and est0 == row["true_betti0"] and est1 == row["true_betti1"]
         records.append({
-            "cell": cell_of(config), "held_out": has_held_out_family(config),
+            "cell": cell_of(config), "index": row["replicate"], "held_out": has_held_out_family(config),
             "agents": config["swarm"]["agents"], "duration": config["swarm"]["duration"],
             "area": case_area(config), "true_betti0": row["true_betti0"], "true_betti1": row["true_betti1"],
             "est_betti0": est0, "est_betti1": est1, "confidence_betti0": conf0, "confidence_betti1": conf1,
@@ -351,6 +355,11 @@ def markdown(summary: dict[str, Any], command: str) -> str:
     lines.append("| mean seconds per map | " + " | ".join(
         f"{summary['pipelines'][n]['mean_seconds']:.2f}" if summary["pipelines"][n]["mean_seconds"] else "-"
         for n in names) + " |")
+    in_slice = [r for r in summary["records"] if r["index"] < SLICE_PER_CELL]
+    if len(in_slice) == SLICE_PER_CELL * len(summary["pipelines"]["default"]["table"]["cells"]):
+        lines += ["", f"Regression slice: {sum(r['right'] for r in in_slice)}/{len(in_slice)} exact (the first "
+                      f"{SLICE_PER_CELL} reporting cases of every cell, default pipeline; tests/test_accuracy.py "
+                      "reruns them and fails below the 1 % binomial quantile of this rate)."]
     for n_dim in ("1", "0"):
         rel = summary["pipelines"]["default"]["reliability"][n_dim]
         if not rel["maps"]:

@@ -158,9 +158,10 @@ def reproduce(name: str, out: Path, *, runs: int | None = None, progress: Progre
 
 
 # -- measures ---------------------------------------------------------------------------
-def h1_bars(diagram: Diagram) -> dict[str, float]:
+def h1_bars(diagram: Diagram, power=None) -> dict[str, float]:
     """Longest and second-longest dgm_1 bar (0 if missing), their ratio (inf with
-    one bar, NaN with none) and the paper's SNR given the true beta_1 = 1."""
+    one bar, NaN with none) and the paper's SNR given the true beta_1 = 1 (``power``:
+    that ``snr`` when the caller has it)."""
     lengths = diagram.lengths(1)
     longest = float(lengths[0]) if len(lengths) else 0.0
     second = float(lengths[1]) if len(lengths) > 1 else 0.0
@@ -168,7 +169,8 @@ def h1_bars(diagram: Diagram) -> dict[str, float]:
         ratio = longest / second
     else:
         ratio = float("inf") if longest > 0 else float("nan")
-    return {"longest_h1": longest, "second_h1": second, "ratio": ratio, "snr": snr(diagram, 1, TRUE_BETA1).ratio}
+    power = power or snr(diagram, 1, TRUE_BETA1)
+    return {"longest_h1": longest, "second_h1": second, "ratio": ratio, "snr": power.ratio}
 
 
 @dataclass(frozen=True)
@@ -428,7 +430,7 @@ def reproduce_land2(out: Path, *, runs: int | None = None, progress: Progress | 
             power = snr(diagram, 1, TRUE_BETA1)
             rows.append({"run": r, "landmark_seed": landmark_seed, "method": method, "landmarks": len(land.nodes),
                          "cover_radius": land.cover_radius, "beta_1": classifier.betti(diagram)[1],
-                         **h1_bars(diagram), "signal_power": power.signal_power, "noise_power": power.noise_power})
+                         **h1_bars(diagram, power), "signal_power": power.signal_power, "noise_power": power.noise_power})
             if r == 0:
                 first[method] = (land, diagram)
             tick(failed=False)

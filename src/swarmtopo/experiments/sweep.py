@@ -45,9 +45,9 @@ from .store import JOB_COLUMNS, ResultStore
 WORKER_WAIT = 120.0
 """Seconds ``run_sweep`` waits for a first worker on an existing scheduler."""
 CONNECT_TIMEOUT = 10.0
+"""Seconds ``run_sweep`` tries to reach an existing scheduler."""
 POLL_SECONDS = 0.05
 """How often ``run_sweep`` looks for finished jobs and for Ctrl-C while it waits."""
-"""Seconds ``run_sweep`` tries to reach an existing scheduler."""
 _STAGE_COLUMNS = {"graph": "t_graph", "landmarks": "t_landmarks", "persistence": "t_persistence",
                   "classify": "t_classify"}
 
@@ -322,8 +322,11 @@ def _dask_client(scheduler: str | None, workers: int | None, n_jobs: int):
     # core in every worker (BLAS / OpenMP threads are already 1 under Dask's nanny).  The
     # scheduler's HTTP server takes any free port (8787 may be another cluster's).  The
     # workers preload this module (its imports take seconds) and run its dask_setup.
+    # Only CRITICAL logs: a job's own exception reaches the client through its future,
+    # and after Ctrl-C a worker may log an ERROR with a traceback ("failed to communicate
+    # with scheduler during heartbeat") while the cluster it belongs to shuts down.
     with LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=":0",
-                      silence_logs=logging.ERROR, env={"NUMBA_NUM_THREADS": "1"}, preload=[__name__]) as cluster:
+                      silence_logs=logging.CRITICAL, env={"NUMBA_NUM_THREADS": "1"}, preload=[__name__]) as cluster:
         with Client(cluster) as client:
             yield client, n_workers
 
