@@ -42,6 +42,32 @@ def test_quantile_test_hand_computed():
     assert window_margin(d, 1, 1.0, th) == pytest.approx(np.log(4 / 3))
 
 
+def test_gap_rule_hand_computed():
+    # lengths 10, 9, 3, 2.8, 1, 1, 1 and an infinite bar; tau ~ 0: every bar a candidate.
+    # Gaps ln(10/9), ln 3, ln(3/2.8), ln 2.8, 0, 0, 0 (none after the last): the largest,
+    # ln 3 after the 2nd bar, cuts -> the two longest and the infinite bar count.
+    d = diagram([[1, 11], [1, 10], [1, 4], [1, 3.8], [1, 2], [2, 3], [3, 4], [1, np.inf]])
+    th = RatioThresholds(q=0.5, tau=1e-9, gamma=1.5)
+    assert {tuple(d[1][i]) for i in counted_bars(d, 1, 1.0, th)} == {(1.0, 11.0), (1.0, 10.0), (1.0, np.inf)}
+    # margin: the largest gap ln 3 over the next largest ln 2.8 and over ln 1.5
+    assert window_margin(d, 1, 1.0, th) == pytest.approx(min(np.log(3 / 2.8), np.log(3 / 1.5)))
+    # gamma above every gap: only the infinite bar
+    assert [tuple(d[1][i]) for i in counted_bars(d, 1, 1.0, RatioThresholds(0.5, 1e-9, gamma=3.5))] == [(1.0, np.inf)]
+    # a floor: l_q = median(10, 9, 3, 2.8, 1, 1, 1) = 2.8, tau 1.1 -> candidates are the
+    # lengths > 3.08, 10 and 9; the largest gap among them, after 9, cuts: 2 (+ inf)
+    assert len(counted_bars(d, 1, 1.0, RatioThresholds(0.5, 1.1, gamma=1.0))) == 3
+    # without the gap rule every candidate counts: with tau ~ 0, all 7 (+ inf)
+    assert len(counted_bars(d, 1, 1.0, RatioThresholds(0.5, 1e-9))) == 8
+
+
+def test_version_1_files_read_with_the_gap_rule_off():
+    old = {"format": "swarmtopo-ratio-classifier/1",
+           "thresholds": {"1": {"q": 0.5, "tau": 2.0, "rho": 1.0, "kappa": 0.0}}}
+    model = RatioClassifier.from_json(old)
+    assert model.thresholds_[1].gamma == 0.0
+    assert model.to_json()["format"] == "swarmtopo-ratio-classifier/2"
+
+
 def test_bar_born_at_zero_has_infinite_ratio():
     d = diagram([[0.0, 2.0]])
     assert len(counted_bars(d, 1, 1.0, TH)) == 1
@@ -85,8 +111,9 @@ def test_vote_without_windows_is_an_error():
 def test_counts_are_scale_invariant(bars, cover, c):
     # multiplying every distance by c multiplies births, deaths and r_cover by c
     h1 = [[b, b + length] for b, length in bars]
-    model = RatioClassifier({1: RatioThresholds(0.5, 2.0, 2.0, 1.5)})
-    assert model.betti(diagram(h1), cover) == model.betti(diagram(np.array(h1).reshape(-1, 2) * c), cover * c)
+    for th in (RatioThresholds(0.5, 2.0, 2.0, 1.5), RatioThresholds(0.5, 1.5, gamma=1.2)):
+        model = RatioClassifier({1: th})
+        assert model.betti(diagram(h1), cover) == model.betti(diagram(np.array(h1).reshape(-1, 2) * c), cover * c)
 
 
 def test_calibration_and_json_round_trip(tmp_path):
@@ -117,6 +144,8 @@ def test_bad_thresholds_and_files_are_input_errors(tmp_path):
         RatioClassifier({1: RatioThresholds(0.5, 2.0, rho=0.5)})
     with pytest.raises(InputError, match="q <= 1"):
         RatioClassifier({1: RatioThresholds(1.5, 2.0)})
+    with pytest.raises(InputError, match="gamma 0 or >= 1"):
+        RatioClassifier({1: RatioThresholds(0.5, 2.0, gamma=0.5)})
     with pytest.raises(InputError, match="malformed"):
         RatioClassifier.from_json({"format": "swarmtopo-ratio-classifier/1", "thresholds": {"1": {"rho": "x"}}})
 

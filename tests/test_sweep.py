@@ -86,8 +86,8 @@ def test_grid_is_the_product_of_lists_times_replicates_with_defaults():
         "arena": {"generator": "random", "holes": job.config["arena"]["holes"], "shapes": ["square"],
                   "outer": "square", "scale": 1.0},
         "swarm": {"agents": job.config["swarm"]["agents"], "duration": 20.0, "static_fraction": 0.0},
-        "map": {"metric": "hybrid", "hop_cost": "auto", "window_length": 20.0, "window_step": "auto",
-                "subsample": "maxmin", "landmarks": "auto", "max_landmarks": 400, "maxdim": 1, "classifier": "default"},
+        "map": {"metric": "hybrid", "hop_cost": "auto", "window_length": "auto", "window_encounters": 25.0,
+                "window_step": "auto", "subsample": "maxmin", "landmarks": "auto", "max_landmarks": 400, "maxdim": 1, "classifier": "default"},
     }
     # max_landmarks only caps "auto": a fixed L drops it
     assert "max_landmarks" not in next(j for j in sweep.jobs if j.config["map"]["landmarks"] == 150).config["map"]
@@ -161,7 +161,9 @@ def test_keys_are_the_same_in_another_process():
     ("[map]\nmetric = 'hybird'", ['[map] metric = "hybird"', "plain, contracted, hybrid"]),
     ("[map]\nlandmarks = 100\nmax_landmarks = 500", ["[map] max_landmarks", "landmarks is a number"]),
     ("[map]\nhop_cost = -2", ["[map] hop_cost = -2", '>= 0 or "auto"']),
-    ("[map]\nwindow_length = 'all'", ['[map] window_length = "all"', '> 0 or "none"']),
+    ("[map]\nwindow_length = 'all'", ['[map] window_length = "all"', '> 0 or "auto" or "none"']),
+    ("[map]\nwindow_length = 20\nwindow_encounters = 30", ["[map] window_encounters", 'window_length is not "auto"']),
+    ("[map]\nwindow_encounters = 0", ["[map] window_encounters = 0", "> 0"]),
     ("[map]\nwindow_length = 'none'\nwindow_step = 5", ["[map] window_step", 'window_length is "none"']),
     ("[map]\nclassifier = 'nope.json'", ['[map] classifier = "nope.json"', "cannot read"]),
     ("[arena]\nholes = []", ["[arena] holes = []", "empty list"]),
@@ -191,7 +193,8 @@ def test_cli_bad_config_is_one_line_exit_1(tmp_path):
     proc = run_cli("sweep", path, "--store", tmp_path / "r.duckdb")
     assert proc.returncode == 1 and "Traceback" not in proc.stderr
     assert proc.stderr.strip().splitlines() == [f"error: {path}: [map] metrc: unknown key; expected one of "
-                                                "metric, hop_cost, window_length, window_step, subsample, landmarks, "
+                                                "metric, hop_cost, window_length, window_encounters, window_step, "
+                                                "subsample, landmarks, "
                                                 "max_landmarks, maxdim, classifier"]
     assert not (tmp_path / "r.duckdb").exists()
 
@@ -238,7 +241,7 @@ def test_run_job_row_is_deterministic_and_consistent():
 
 
 def test_user_errors_are_rows_with_null_estimates(tmp_path):
-    job = expand_grid({"swarm": {"agents": 5, "duration": 5}}).jobs[0]
+    job = expand_grid({"swarm": {"agents": 1, "duration": 5}}).jobs[0]  # one agent never meets anyone
     row = run_job(job)
     assert row["error"] == "the log has 0 event(s); at least 2 encounters are needed to build a map"
     assert row["est_betti0"] is None and row["lengths_h1"] is None and row["snr_h1"] is None

@@ -55,11 +55,12 @@ def non_negative_int(name: str, value) -> int:
     return n
 
 
-def check_format(obj, expected: str, what: str, source: str) -> dict:
-    """``obj`` if it is a JSON object whose ``format`` is ``expected``; else an
-    InputError naming ``source`` and the format found."""
-    if not isinstance(obj, dict) or obj.get("format") != expected:
-        raise InputError(f"not a {what} (expected \"format\": \"{expected}\")", file=source, column="format",
+def check_format(obj, expected: str | tuple[str, ...], what: str, source: str) -> dict:
+    """``obj`` if it is a JSON object whose ``format`` is ``expected`` (or one of them,
+    the newest last); else an InputError naming ``source`` and the format found."""
+    accepted = (expected,) if isinstance(expected, str) else tuple(expected)
+    if not isinstance(obj, dict) or obj.get("format") not in accepted:
+        raise InputError(f"not a {what} (expected \"format\": \"{accepted[-1]}\")", file=source, column="format",
                          value=obj.get("format") if isinstance(obj, dict) else obj)
     return obj
 

@@ -424,7 +424,7 @@ def load_classifier(name: str | Path):
     ``format`` key says which).
     """
     from .io import read_json
-    from .ratio import RATIO_FORMAT, RatioClassifier
+    from .ratio import READ_FORMATS, RatioClassifier
 
     if str(name) in PRESETS:
         source = f"swarmtopo/data/classifier-{name}.json"
@@ -435,7 +435,7 @@ def load_classifier(name: str | Path):
             raise InputError(f"no such classifier: expected one of {', '.join(PRESETS)} or a JSON file",
                              file=str(path), value=str(name))
         source, obj = str(path), read_json(path)
-    if isinstance(obj, dict) and obj.get("format") == RATIO_FORMAT:
+    if isinstance(obj, dict) and obj.get("format") in READ_FORMATS:
         return RatioClassifier.from_json(obj, source=source)
     return BettiClassifier.from_json(obj, source=source)
 

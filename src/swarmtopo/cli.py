@@ -170,12 +170,12 @@ def _parse_window(text: Optional[str]):
 
 
 def _parse_window_length(text: Optional[str]):
-    if text is None or text == "none":
+    if text is None or text in ("auto", "none"):
         return text
     try:
         value = float(text)
     except ValueError:
-        raise typer.BadParameter(f"{text!r} is not a number of seconds or 'none'") from None
+        raise typer.BadParameter(f"{text!r} is not a number of seconds, 'auto' or 'none'") from None
     if not (math.isfinite(value) and value > 0):
         raise typer.BadParameter(f"{text!r}: the window length must be a positive number of seconds")
     return text
@@ -201,7 +201,8 @@ def map_command(
              "(default: r_d / v_c from meta.json, else from the data)."),
     window_length: Optional[str] = typer.Option(
         None, "--window-length", callback=_parse_window_length,
-        help="Seconds of the time windows whose maps vote; 'none' maps the whole log at once (default 15)."),
+        help="Seconds of the time windows whose maps vote; 'none' maps the whole log at once; 'auto' (default) "
+             "holds about 25 encounters per agent (25 x the mean time between an agent's encounters)."),
     classifier: Optional[str] = typer.Option(
         None, "--classifier",
         help="Betti classifier: default (tuned on the accuracy benchmark), paper-form (the paper's form trained "
@@ -215,7 +216,7 @@ def map_command(
     """Map an encounter log folder: Betti numbers with confidence, diagrams and pictures."""
     from .classify import load_classifier
     from .io import read_log
-    from .pipeline import MapConfig
+    from .pipeline import WHOLE_LOG, MapConfig
 
     _check_verbosity(quiet, verbose)
     if paper:
@@ -229,8 +230,8 @@ def map_command(
     log = read_log(log_dir)
     config = MapConfig(metric=metric, subsample=subsample, landmarks=landmarks, window=window, maxdim=maxdim,
                        seed=seed, hop_cost=hop_cost,
-                       window_length=(MapConfig.window_length if window_length is None else
-                                      None if window_length == "none" else float(window_length)))
+                       window_length={None: None, "auto": None, "none": WHOLE_LOG}.get(window_length)
+                       if window_length in (None, "auto", "none") else float(window_length))
     if verbose:
         _detail(f"log {log_dir}: {log.n_events} encounters of {log.n_agents} agents over {log.duration:g} s")
     tmap, written = _run_map(log, config, log_dir, out_dir, quiet, verbose, classifier=model)
@@ -506,10 +507,11 @@ def _map_details(tmap) -> None:
                 f"threshold {', '.join(f'{v:.3g} s' for v in r.thresholds.values())}; "
                 f"{len(r.cycles)} loop(s) found")
         if len(r.windows) > 1:
-            _detail(f"region {r.component}: {len(r.windows)} windows of {tmap.config.window_length:g} s counted "
+            _detail(f"region {r.component}: {len(r.windows)} windows of {tmap.window_length[0]:.3g} s counted "
                     f"{[w.betti.get(1) for w in r.windows]} holes; vote {r.betti.get(1)}, shown: window "
                     f"{r.window} [{r.windows[r.window].t0:.1f}, {r.windows[r.window].t1:.1f}] s")
-    _detail(f"per-hop cost h = {tmap.hop_cost[0]:.3g} s ({tmap.hop_cost[1]})")
+    _detail(f"per-hop cost h = {tmap.hop_cost[0]:.3g} s ({tmap.hop_cost[1]}); window "
+            f"{tmap.window_length[0]:.3g} s ({tmap.window_length[1]})")
 
 
 def _ground_truth(log, log_dir: Path, quiet: bool):

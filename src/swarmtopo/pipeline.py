@@ -52,6 +52,8 @@ ADVICE_BELOW = 0.8
 HOP_GAP_FACTOR = 2.0
 """Without r_d and v_c in meta.json, the per-hop cost h is this many times the mean time
 between an agent's consecutive encounters (docs/accuracy.md, "Real traces")."""
+WHOLE_LOG = float("inf")
+"""``MapConfig.window_length`` that maps the whole log at once (the paper)."""
 STAGES = ("graph", "landmarks", "persistence", "embedding", "classify", "cycles")
 """Stage names passed to ``map_encounters``'s progress callback, in order."""
 
@@ -73,8 +75,15 @@ class MapConfig:
         ``HOP_GAP_FACTOR`` x the mean time between an agent's encounters.
     window_length
         Length (s) of the time windows each region is mapped in; the region's Betti
-        numbers are voted across them (:func:`swarmtopo.ratio.vote`).  None maps the
-        whole log at once (the paper).
+        numbers are voted across them (:func:`swarmtopo.ratio.vote`).  None (default):
+        from the data, ``window_encounters`` times the mean time between an agent's
+        consecutive encounters, so a window holds about that many encounters per
+        agent whatever the swarm's density (:func:`resolve_window`).  ``WHOLE_LOG``
+        (inf) maps the whole log at once (the paper); so does any length not shorter
+        than the log.
+    window_encounters
+        K, the encounters per agent an automatic window holds (default 25, chosen on
+        the benchmark's tuning cases: docs/tuning.md).
     window_step
         Seconds between the starts of consecutive windows; None (default) = half the
         window length, so windows overlap by half and a log of T seconds gets
@@ -114,7 +123,8 @@ class MapConfig:
 
     metric: str = "hybrid"
     hop_cost: float | None = None
-    window_length: float | None = 20.0
+    window_length: float | None = None
+    window_encounters: float = 25.0
     window_step: float | None = None
     subsample: str = "maxmin"
     landmarks: int | None = None
@@ -141,8 +151,10 @@ class MapConfig:
             raise SwarmtopoError(f"max_landmarks must be at least 3, got {self.max_landmarks}")
         if self.hop_cost is not None and not (np.isfinite(self.hop_cost) and self.hop_cost >= 0):
             raise SwarmtopoError(f"hop_cost must be a number of seconds >= 0, got {self.hop_cost}")
-        if self.window_length is not None and not (np.isfinite(self.window_length) and self.window_length > 0):
+        if self.window_length is not None and not self.window_length > 0:
             raise SwarmtopoError(f"window_length must be a positive number of seconds, got {self.window_length}")
+        if not (np.isfinite(self.window_encounters) and self.window_encounters > 0):
+            raise SwarmtopoError(f"window_encounters must be a positive number, got {self.window_encounters}")
         if self.window_step is not None and not (np.isfinite(self.window_step) and self.window_step > 0):
             raise SwarmtopoError(f"window_step must be a positive number of seconds, got {self.window_step}")
         if self.maxdim not in (1, 2):
@@ -231,6 +243,7 @@ class TopologicalMap:
     n_events: int
     n_agents: int
     hop_cost: tuple[float, str] = (0.0, "given")  # (h used, where it came from)
+    window_length: tuple[float, str] = (WHOLE_LOG, "given")  # (window length used, where it came from)
     software: dict[str, str] = field(default_factory=dict)
 
     @property
@@ -248,10 +261,11 @@ class TopologicalMap:
             counts = [w.betti.get(1) for w in r.windows]
             if len(set(counts)) > 1:
                 lines.append(f"region {r.component}: its {len(counts)} time windows counted {counts} holes")
-        step = self.config.window_step or (self.config.window_length or 20.0) / 2
-        lines.append(f"to raise it: record longer (each extra {step:g} s adds a window to "
-                     f"the vote), use more agents than {self.n_agents} (denser windows), or leave some agents "
-                     "static (hybrid metric: free links across time); 'swarmtopo plan --area A --agents N "
+        length = self.window_length[0]
+        more_time = (f"record longer (each extra {self.config.window_step or length / 2:.3g} s adds a window to "
+                     "the vote)" if np.isfinite(length) else "record longer")
+        lines.append(f"to raise it: {more_time}, use more agents than {self.n_agents} (denser windows), or leave "
+                     "some agents static (hybrid metric: free links across time); 'swarmtopo plan --area A --agents N "
                      "--target 0.95' tells how much")
         return lines
 
@@ -286,7 +300,9 @@ class TopologicalMap:
             ],
             "too_little_data": self.too_little_data,
             "params": {**jsonable(asdict(self.config)), "hop_cost_used": self.hop_cost[0],
-                       "hop_cost_source": self.hop_cost[1]},
+                       "hop_cost_source": self.hop_cost[1],
+                       "window_length_used": self.window_length[0] if np.isfinite(self.window_length[0]) else None,
+                       "window_source": self.window_length[1]},
             "log": {"events": self.n_events, "agents": self.n_agents},
             "timings": {k: round(v, 6) for k, v in self.timings.items()},
             "software": {**self.software, "persistence_backend": self.diagram.backend},
@@ -349,7 +365,10 @@ def map_encounters(
 
     shares = (_share_landmarks(config.landmarks, events_per_comp[regions_idx]) if config.landmarks
               else [None] * len(regions_idx))
-    spans = _windows(graph.event_t, config.window_length, config.window_step)
+    mapped = log if config.window is None else log.window(*config.window)
+    window_length, window_source = resolve_window(mapped, config.window_length, config.window_encounters,
+                                                  float(graph.event_t.max() - graph.event_t.min()))
+    spans = _windows(graph.event_t, window_length, config.window_step)
     window_graphs = [(None, graph, labels)]  # (span, graph, component labels) of each window
     if len(spans) > 1:
         window_graphs = []
@@ -431,6 +450,7 @@ def map_encounters(
         n_events=graph.n_events,
         n_agents=log.n_agents,
         hop_cost=(hop_cost, hop_source),
+        window_length=(window_length, window_source),
         software=software_versions(),
     )
 
@@ -467,20 +487,42 @@ def resolve_hop_cost(log: EncounterLog, hop_cost: float | None) -> tuple[float, 
     r_d, v_c = log.meta.get("r_d"), log.meta.get("v_c")
     if all(isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) and x > 0 for x in (r_d, v_c)):
         return float(r_d) / float(v_c), "r_d / v_c from meta.json"
+    gap = _mean_agent_gap(log)
+    if gap is None:
+        return 0.0, "no agent met twice at different times: 0"
+    return HOP_GAP_FACTOR * gap, f"{HOP_GAP_FACTOR:g} x mean time between an agent's encounters"
+
+
+def resolve_window(log: EncounterLog, window_length: float | None, encounters: float,
+                   span: float) -> tuple[float, str]:
+    """(window length W used, where it came from): the given length, else W = K x the
+    mean time between an agent's consecutive encounters in ``log`` (the mapped events; K =
+    ``encounters``), so a window holds about K encounters per agent; ``WHOLE_LOG`` when
+    W is not shorter than ``span``, the seconds the mapped events cover."""
+    if window_length is not None:
+        return (float(window_length) if window_length < span else WHOLE_LOG), "given"
+    gap = _mean_agent_gap(log)
+    if gap is None:
+        return WHOLE_LOG, "no agent met twice at different times: the whole log"
+    length = encounters * gap
+    source = f"{encounters:g} x mean time between an agent's encounters"
+    return (length, source) if length < span else (WHOLE_LOG, source + " (longer than the log: the whole log)")
+
+
+def _mean_agent_gap(log: EncounterLog) -> float | None:
+    """Mean time between an agent's consecutive encounters at different times (None: none)."""
     gaps = agent_gaps(log)
     gaps = gaps[gaps > 0]
-    if not len(gaps):
-        return 0.0, "no agent met twice at different times: 0"
-    return HOP_GAP_FACTOR * float(gaps.mean()), f"{HOP_GAP_FACTOR:g} x mean time between an agent's encounters"
+    return float(gaps.mean()) if len(gaps) else None
 
 
-def _windows(event_t: np.ndarray, length: float | None, step: float | None = None) -> list[tuple[float, float] | None]:
+def _windows(event_t: np.ndarray, length: float, step: float | None = None) -> list[tuple[float, float] | None]:
     """Time windows of ``length`` s over [t_first, t_last], starts at most ``step`` apart
     (default length / 2): 1 + ceil((span - length) / step) of them, evenly spaced from
-    the first event to the last; [None] (the whole log) without a length or when the
-    span is not longer than one window."""
+    the first event to the last; [None] (the whole log) when the span is not longer
+    than one window."""
     t_first, t_last = float(event_t.min()), float(event_t.max())
-    if length is None or t_last - t_first <= length:
+    if t_last - t_first <= length:
         return [None]
     step = length / 2 if step is None else step
     n = 1 + int(np.ceil((t_last - t_first - length) / step - 1e-9))

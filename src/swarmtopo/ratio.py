@@ -15,22 +15,32 @@ multiplied by a constant:
 * the **length in covering radii** l / r_cover: subsampling moves no bar by more than
   2 r_cover, so a bar much shorter than r_cover may be a subsampling artefact.
 
-A bar of dimension n counts when it passes all three (rho_n = 1 and kappa_n = 0 switch
-the last two off)::
+A bar of dimension n is a *candidate* when it passes all three (rho_n = 1 and kappa_n
+= 0 switch the last two off)::
 
-    beta_hat_n(window) = #{ i : l_i > tau_n l_q  and  d_i / b_i > rho_n  and  l_i > kappa_n r_cover }
+    C_n = { i : l_i > tau_n l_q  and  d_i / b_i > rho_n  and  l_i > kappa_n r_cover }
 
-(an infinite bar always counts; b = 0 gives pi = inf; l_q is over the finite bars).  A region's log is cut into
-time windows (``MapConfig.window_length``), each window is mapped on its own, and the
-region's beta_hat_n is the **median** of the windows' counts (the lower median for an
-even number of windows).
+(an infinite bar always counts; b = 0 gives pi = inf; l_q is over the finite bars).
+With gamma_n = 0 every candidate counts: beta_hat_n(window) = |C_n|.  With gamma_n >= 1
+the **largest gap** decides: sort the finite bars by length, l_(1) >= l_(2) >= ...,
+let g_k = ln(l_(k) / l_(k+1)) (g = 0 after the last bar: a bar with none below it
+shows no gap), and among the ranks k of candidates take k* = argmax g_k; the
+candidates among the k* longest bars count if g_k* >= ln gamma_n, none otherwise (the
+noise bars' top end moves from sample to sample; a loop round an obstacle may stand
+above it by a gap).  Tuning keeps the gap rule only where it is right more often; for
+the shipped default it was not (docs/tuning.md), so its gamma_1 is 0.
+
+A region's log is cut into time windows (``MapConfig.window_length``), each window is
+mapped on its own, and the region's beta_hat_n is the **median** of the windows'
+counts (the lower median for an even number of windows).
 
 Confidence.  For each region the features are the *agreement* a (fraction of
 windows whose count equals the vote) and the *margin* m of the window that represents
-the region: how far, in log units, its nearest bar is from changing its verdict (a
-counted bar flips when any test fails, an uncounted one needs every failing test to
-pass), capped at MAX_MARGIN.  P(correct | a, m, number of windows) is a logistic
-regression fitted on the benchmark's tuning maps (:meth:`RatioClassifier.calibrate`).
+the region: how far, in log units, its count is from changing (without the gap rule:
+its nearest bar's distance to a threshold -- a counted bar flips when any test fails,
+an uncounted one needs every failing test to pass; with it: how much the largest gap
+exceeds the next largest and ln gamma_n), capped at MAX_MARGIN.  P(correct | a, m,
+number of windows) is a logistic regression fitted on the benchmark's tuning maps (:meth:`RatioClassifier.calibrate`).
 """
 
 from __future__ import annotations
@@ -47,7 +57,9 @@ from ._validate import check_format
 from .errors import InputError, SwarmtopoError
 from .persistence import Diagram
 
-RATIO_FORMAT = "swarmtopo-ratio-classifier/1"
+RATIO_FORMAT = "swarmtopo-ratio-classifier/2"
+READ_FORMATS = ("swarmtopo-ratio-classifier/1", RATIO_FORMAT)
+"""Readable formats: /1 files have no gamma (the gap rule off)."""
 MAX_MARGIN = 3.0
 """Cap of the log margin of a window's nearest bar (a bar e^3 = 20 times off both
 thresholds is as sure as it gets)."""
@@ -63,15 +75,16 @@ class WindowBars:
 
 @dataclass(frozen=True)
 class RatioThresholds:
-    """(q_n, tau_n, rho_n, kappa_n) of one dimension (module docstring)."""
+    """(q_n, tau_n, rho_n, kappa_n, gamma_n) of one dimension (module docstring)."""
 
     q: float
     tau: float
     rho: float = 1.0
     kappa: float = 0.0
+    gamma: float = 0.0
 
     def to_json(self) -> dict[str, float]:
-        return {"q": self.q, "tau": self.tau, "rho": self.rho, "kappa": self.kappa}
+        return {"q": self.q, "tau": self.tau, "rho": self.rho, "kappa": self.kappa, "gamma": self.gamma}
 
 
 def _log_tests(diagram: Diagram, dim: int, cover_radius: float, th: RatioThresholds) -> np.ndarray:
@@ -97,18 +110,47 @@ def counted_bars(diagram: Diagram, dim: int, cover_radius: float, th: RatioThres
     """Indices into ``diagram[dim]`` of the bars that count (module docstring)."""
     if dim > diagram.maxdim or not len(diagram[dim]):
         return np.empty(0, np.int64)
-    return np.flatnonzero((_log_tests(diagram, dim, cover_radius, th) > 0).all(axis=1))
+    candidate = (_log_tests(diagram, dim, cover_radius, th) > 0).all(axis=1)
+    if th.gamma <= 0:
+        return np.flatnonzero(candidate)
+    finite, order, gaps = ranked_gaps(diagram[dim])
+    out = np.flatnonzero(candidate & ~finite)
+    ranks = np.flatnonzero(candidate[order])
+    if len(ranks):
+        k = ranks[int(np.argmax(gaps[ranks]))]
+        if gaps[k] >= np.log(th.gamma):
+            out = np.union1d(out, order[:k + 1][candidate[order[:k + 1]]])
+    return out
+
+
+def ranked_gaps(pairs: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(finite mask, indices of the finite bars by decreasing length, g_k = ln(l_(k) /
+    l_(k+1)) capped at MAX_MARGIN, 0 after the last)."""
+    length = pairs[:, 1] - pairs[:, 0]
+    finite = np.isfinite(length)
+    index = np.flatnonzero(finite)
+    order = index[np.argsort(-length[index], kind="stable")]
+    ranked = length[order]
+    with np.errstate(divide="ignore"):
+        gaps = np.r_[np.log(ranked[:-1] / ranked[1:]), 0.0] if len(ranked) else np.empty(0)
+    return finite, order, np.minimum(gaps, MAX_MARGIN)
 
 
 def window_margin(diagram: Diagram, dim: int, cover_radius: float, th: RatioThresholds) -> float:
-    """m: how far, in log units, the window's nearest bar is from changing its verdict."""
+    """m: how far, in log units, the window's count is from changing (module docstring)."""
     if dim > diagram.maxdim or not len(diagram[dim]):
         return MAX_MARGIN
     tests = _log_tests(diagram, dim, cover_radius, th)
     counted = (tests > 0).all(axis=1)
     # a counted bar flips when its weakest test fails; an uncounted one needs every failing test to pass
     flip = np.where(counted, tests.min(axis=1), (-np.minimum(tests, 0)).max(axis=1))
-    return float(min(MAX_MARGIN, flip.min()))
+    finite, order, gaps = ranked_gaps(diagram[dim])
+    ranks = np.flatnonzero(counted[order])
+    if th.gamma <= 0 or not len(ranks):
+        return float(min(MAX_MARGIN, flip.min()))
+    ranked = np.sort(gaps[ranks])[::-1]
+    runner_up = ranked[1] if len(ranked) > 1 else -np.inf
+    return float(min(MAX_MARGIN, ranked[0] - runner_up, ranked[0] - np.log(th.gamma)))
 
 
 def median_vote(counts: Sequence[int]) -> int:
@@ -157,9 +199,10 @@ class RatioClassifier:
     def __init__(self, thresholds: dict[int, RatioThresholds], calibration: dict | None = None,
                  provenance: dict | None = None):
         for n, th in thresholds.items():
-            if not (int(n) >= 1 and 0.0 <= th.q <= 1.0 and th.tau > 0 and th.rho >= 1.0 and th.kappa >= 0.0):
+            if not (int(n) >= 1 and 0.0 <= th.q <= 1.0 and th.tau > 0 and th.rho >= 1.0 and th.kappa >= 0.0
+                    and (th.gamma == 0.0 or th.gamma >= 1.0)):
                 raise InputError(f"ratio thresholds of dimension {n} out of range "
-                                 "(need 0 <= q <= 1, tau > 0, rho >= 1, kappa >= 0)",
+                                 "(need 0 <= q <= 1, tau > 0, rho >= 1, kappa >= 0, gamma 0 or >= 1)",
                                  column=f"thresholds.{n}", value=th.to_json())
         self.thresholds_ = {int(n): th for n, th in sorted(thresholds.items())}
         self.calibration_ = dict(calibration or {})
@@ -257,9 +300,10 @@ class RatioClassifier:
         """What map.json says about how its Betti numbers were read."""
         return {
             "classifier": self.provenance_.get("name", "custom"),
-            "definition": "beta_n = lower median over time windows of #{bars of dim n with length > tau * l_q, "
-                          "death/birth > rho and length > kappa * r_cover}, l_q = q-quantile of the window's "
-                          "dim-n bar lengths",
+            "definition": "beta_n = lower median over time windows of the count of candidate bars of dim n "
+                          "(length > tau * l_q, death/birth > rho, length > kappa * r_cover; l_q = q-quantile of "
+                          "the window's dim-n bar lengths); with gamma >= 1 only the candidates down to the "
+                          "largest log gap between consecutive bar lengths count, if that gap is >= ln gamma",
             "theta": {str(n): th.to_json() for n, th in self.thresholds_.items()},
             "confidence": "P(correct) from a logistic model of the windows' agreement with the vote, the "
                           "nearest bar's log margin and the number of windows, fitted on the benchmark's "
@@ -281,9 +325,10 @@ class RatioClassifier:
 
     @classmethod
     def from_json(cls, obj: dict, source: str = "<json>") -> "RatioClassifier":
-        check_format(obj, RATIO_FORMAT, "swarmtopo ratio classifier", source)
+        check_format(obj, READ_FORMATS, "swarmtopo ratio classifier", source)
         try:
-            thresholds = {int(n): RatioThresholds(float(t["q"]), float(t["tau"]), float(t["rho"]), float(t["kappa"]))
+            thresholds = {int(n): RatioThresholds(float(t["q"]), float(t["tau"]), float(t["rho"]), float(t["kappa"]),
+                                                  float(t.get("gamma", 0.0)))
                           for n, t in obj["thresholds"].items()}
             return cls(thresholds, obj.get("calibration") or None, obj.get("provenance") or {})
         except (KeyError, TypeError, ValueError, AttributeError) as exc:

@@ -60,8 +60,8 @@ SLICE_PER_CELL = 2
 TUNING_PER_CELL = 12
 
 PIPELINES: dict[str, dict[str, Any]] = {
-    "default": {"metric": "hybrid", "hop_cost": "auto", "window_length": MapConfig.window_length, "window_step": "auto",
-                "classifier": "default"},
+    "default": {"metric": "hybrid", "hop_cost": "auto", "window_length": "auto",
+                "window_encounters": MapConfig.window_encounters, "window_step": "auto", "classifier": "default"},
     "paper": {"metric": "hybrid", "hop_cost": 0.0, "window_length": "none", "classifier": "paper-form"},
 }
 """The pipelines the benchmark compares: swarmtopo's default, and the best

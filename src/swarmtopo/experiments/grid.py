@@ -26,7 +26,9 @@ Format (``examples/sweep-small.toml`` is a commented example)::
     [map]
     metric = "hybrid"         # plain | contracted | hybrid (default hybrid)
     hop_cost = "auto"         # per-hop cost h, s: a number >= 0 (0 = the paper) or "auto" (default)
-    window_length = 20.0      # windows voted over, s: a number > 0 or "none" (whole log, the paper)
+    window_length = "auto"    # windows voted over, s: a number > 0, "auto" (default: window_encounters
+                              # encounters per agent) or "none" (whole log, the paper)
+    window_encounters = 25.0  # K of automatic windows (only with window_length = "auto")
     window_step = "auto"      # s between window starts: a number > 0 or "auto" (half the length)
     subsample = "maxmin"      # maxmin | knn | probabilistic (default maxmin)
     landmarks = "auto"        # an integer L >= 3, or "auto" (default)
@@ -138,15 +140,17 @@ def _shape_set(value) -> tuple[str, ...]:
     return tuple(sorted(set(shapes)))
 
 
-def _or_word(word: str, check: Callable[[Any], float]) -> Callable[[Any], Any]:
-    """A number passing ``check``, or the string ``word`` ("auto", "none")."""
+def _or_word(words: str | tuple[str, ...], check: Callable[[Any], float]) -> Callable[[Any], Any]:
+    """A number passing ``check``, or one of the strings ``words`` ("auto", "none")."""
+    words = (words,) if isinstance(words, str) else words
+
     def either(value):
-        if value == word:
+        if value in words:
             return value
         try:
             return check(value)
         except _Bad as exc:
-            raise _Bad(f"{exc} or \"{word}\"") from None
+            raise _Bad(f"{exc} or " + " or ".join(f'"{w}"' for w in words)) from None
     return either
 
 
@@ -184,7 +188,8 @@ PARAMS: tuple[Param, ...] = (
     Param("swarm", "static_time", 0.0, _number(0.0, strict=False), "DOUBLE"),
     Param("map", "metric", "hybrid", _choice(METRICS), "TEXT"),
     Param("map", "hop_cost", "auto", _or_word("auto", _number(0.0, strict=False)), "DOUBLE"),
-    Param("map", "window_length", MapConfig().window_length, _or_word("none", _number(0.0, strict=True)), "DOUBLE"),
+    Param("map", "window_length", "auto", _or_word(("auto", "none"), _number(0.0, strict=True)), "DOUBLE"),
+    Param("map", "window_encounters", MapConfig().window_encounters, _number(0.0, strict=True), "DOUBLE"),
     Param("map", "window_step", "auto", _or_word("auto", _number(0.0, strict=True)), "DOUBLE"),
     Param("map", "subsample", "maxmin", _choice(tuple(SUBSAMPLERS)), "TEXT"),
     Param("map", "landmarks", "auto", _landmarks, "INTEGER"),
@@ -374,13 +379,14 @@ def expand_grid(document: dict, *, source: str = "<grid>", base_dir=None,
 
 
 def flat_columns(config: dict) -> dict[str, Any]:
-    """One value per ``PARAMS`` key (None where the config does not use it; ``landmarks``
-    and ``hop_cost`` None for "auto", ``window_length`` None for "none"): the store's
-    flattened grid columns."""
+    """One value per ``PARAMS`` key (None where the config does not use it; ``landmarks``,
+    ``hop_cost``, ``window_length`` and ``window_step`` None for "auto", ``window_length``
+    inf for "none", the whole log): the store's flattened grid columns."""
     flat = {}
     for p in PARAMS:
         value = config.get(p.table, {}).get(p.name)
-        flat[p.name] = None if value in ("auto", "none") else value
+        flat[p.name] = (float("inf") if (p.name, value) == ("window_length", "none")
+                        else None if value in ("auto", "none") else value)
     return flat
 
 
@@ -462,6 +468,8 @@ def _canonical(point: dict, inputs: _InputFiles, fail):
                for name in ("metric", "hop_cost", "window_length", "subsample", "landmarks", "maxdim", "classifier")}
     if mapping["window_length"] != "none":
         mapping["window_step"] = point[("map", "window_step")]
+    if mapping["window_length"] == "auto":
+        mapping["window_encounters"] = point[("map", "window_encounters")]
     if mapping["landmarks"] == "auto":
         mapping["max_landmarks"] = point[("map", "max_landmarks")]
     if mapping["classifier"] not in PRESETS:
@@ -485,6 +493,8 @@ def _unused_reason(table: str, key: str, document: dict) -> str:
         return "not used: static_fraction is 0 (no agent stops for good)"
     if key == "window_step":
         return 'not used: window_length is "none" (the whole log at once)'
+    if key == "window_encounters":
+        return 'not used: window_length is not "auto" (a length in seconds, or "none")'
     return 'not used: landmarks is a number (max_landmarks caps landmarks = "auto")'
 
 

@@ -3,7 +3,7 @@
 ``scripts/tune_accuracy.py`` runs the tuning jobs of candidate pipelines
 (:func:`~.accuracy.tuning_jobs`, inside :func:`~.accuracy.tuning_session`), then for
 each candidate fits the :class:`~swarmtopo.ratio.RatioClassifier` thresholds
-(q_1, tau_1, rho_1, kappa_1) by grid search on the stored per-window diagrams -- the
+(q_1, tau_1, gamma_1) by grid search on the stored per-window diagrams -- the
 thresholds change only which bars count, so no job is rerun -- and keeps the
 candidate with the most exact (beta_0, beta_1) maps.  The confidence model is then
 fitted on the same tuning maps, cross-fitted (:func:`calibrated_classifier`).
@@ -15,14 +15,16 @@ from dataclasses import dataclass
 from typing import Any, Sequence
 
 import numpy as np
+from scipy.ndimage import uniform_filter
 
 from ..persistence import Diagram
-from ..ratio import RatioClassifier, RatioThresholds, WindowBars, counted_bars, median_vote
+from ..ratio import RatioClassifier, RatioThresholds, WindowBars, ranked_gaps, counted_bars, median_vote
 
 Q_GRID = (0.5, 0.6, 0.7, 0.8, 0.9)
-TAU_GRID = tuple(np.round(np.geomspace(1.2, 8.0, 60), 4))
-RHO_GRID = (1.0,) + tuple(np.round(np.geomspace(1.5, 3.0, 12), 4))
-KAPPA_GRID = tuple(np.round(np.arange(0.0, 3.01, 0.25), 2))
+TAU_GRID = tuple(np.round(np.geomspace(1.2, 12.0, 80), 4))
+GAMMA_GRID = (0.0,) + tuple(np.round(np.geomspace(1.0, 2.0, 16), 4))
+"""The (q_1, tau_1, gamma_1) grid; gamma 0 is the gap rule off.  The gates rho_1 and
+kappa_1 stay off: the first tuning round measured that they never raised the rate."""
 
 
 @dataclass(frozen=True)
@@ -63,33 +65,77 @@ def exact(maps: Sequence[TuningMap], th: RatioThresholds) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Fit:
-    """The thresholds chosen, their tuning exact rate, and the (q, tau) surface."""
+    """The thresholds chosen, their tuning exact rate, and the exact-rate surface."""
 
     thresholds: RatioThresholds
     accuracy: float
-    surface: np.ndarray  # (len(Q_GRID), len(TAU_GRID)) exact rate with the gates off
+    surface: np.ndarray  # (len(Q_GRID), len(TAU_GRID), len(GAMMA_GRID)) exact rate
 
 
-def fit_thresholds(maps: Sequence[TuningMap]) -> Fit:
-    """(q_1, tau_1) on a grid with the other two tests off, then the gates (rho_1, kappa_1).
+def window_counts(diagram: Diagram) -> np.ndarray:
+    """beta_hat_1 of one window at every grid point, ``(len(Q_GRID), len(TAU_GRID),
+    len(GAMMA_GRID))``: :func:`~swarmtopo.ratio.counted_bars` with the gates off, at once.
 
-    Each stage keeps the grid point whose neighbourhood (3 x 3, edges repeated) has
-    the highest mean exact rate (ties: the first), so the choice sits inside a plateau
-    rather than on a lucky spike; a gate is switched on only if it raises the rate.
+    Without gates the candidates are the m(q, tau) longest finite bars, so the gap
+    rule's k* is the first argmax of g over ranks < m: a running maximum of g.
     """
-    surface = np.array([[exact(maps, RatioThresholds(q, tau)).mean() for tau in TAU_GRID] for q in Q_GRID])
-    i, j = _plateau(surface)
-    q, tau = Q_GRID[i], TAU_GRID[j]
-    gates = np.array([[exact(maps, RatioThresholds(q, tau, rho, kappa)).mean() for kappa in KAPPA_GRID]
-                      for rho in RHO_GRID])
-    k, m = _plateau(gates)
-    th = RatioThresholds(q, tau, RHO_GRID[k], KAPPA_GRID[m]) if gates[k, m] > surface[i, j] else RatioThresholds(q, tau)
-    return Fit(thresholds=th, accuracy=float(exact(maps, th).mean()), surface=surface)
+    out = np.zeros((len(Q_GRID), len(TAU_GRID), len(GAMMA_GRID)), np.int64)
+    if diagram.maxdim < 1 or not len(diagram[1]):
+        return out
+    finite, order, gaps = ranked_gaps(diagram[1])
+    ranked = (diagram[1][:, 1] - diagram[1][:, 0])[order]
+    out += int((~finite).sum())
+    if not len(ranked):
+        return out
+    best = np.maximum.accumulate(gaps)
+    first = np.array([int(np.argmax(gaps[:i + 1])) for i in range(len(gaps))])  # k* - 1 over the first i + 1 ranks
+    ascending = ranked[::-1]
+    log_gamma = np.log(np.maximum(GAMMA_GRID[1:], 1.0))
+    for i, q in enumerate(Q_GRID):
+        lq = float(np.quantile(ranked, q))
+        m = (len(ranked) - np.searchsorted(ascending, np.asarray(TAU_GRID) * lq, side="right")
+             if lq > 0 else np.full(len(TAU_GRID), len(ranked)))
+        out[i, :, 0] += m
+        has = m > 0
+        top = np.where(has, m - 1, 0)
+        out[i, :, 1:] += np.where(has[:, None] & (best[top][:, None] >= log_gamma[None, :]),
+                                  first[top][:, None] + 1, 0)
+    return out
 
 
-def _plateau(surface: np.ndarray) -> tuple[int, int]:
-    padded = np.pad(surface, 1, mode="edge")
-    smooth = sum(padded[i:i + surface.shape[0], j:j + surface.shape[1]] for i in range(3) for j in range(3)) / 9
+def grid_estimates(maps: Sequence[TuningMap]) -> np.ndarray:
+    """beta_hat_1 of every map at every grid point, regions' windows voted by lower median."""
+    est = np.zeros((len(maps), len(Q_GRID), len(TAU_GRID), len(GAMMA_GRID)), np.int64)
+    for k, m in enumerate(maps):
+        for region in m.regions:
+            counts = np.sort(np.stack([window_counts(w.diagram) for w in region]), axis=0)
+            est[k] += counts[(len(region) - 1) // 2]
+    return est
+
+
+def fit_thresholds(maps: Sequence[TuningMap], gap: bool = True) -> Fit:
+    """(q_1, tau_1) with the gap rule off, and (q_1, tau_1, gamma_1 >= 1) with it on,
+    each at the grid point whose 3 x 3 (x 3) neighbourhood (edges repeated) has the
+    highest mean exact rate (ties: the first), so the choice sits inside a plateau
+    rather than on a lucky spike; the gap rule is kept only if its point is right on
+    more maps.  ``gap=False``: the gap rule is not considered."""
+    truth = np.array([m.true_betti1 for m in maps])
+    beta0 = np.array([m.est_betti0 == m.true_betti0 for m in maps])
+    right = (grid_estimates(maps) == truth[:, None, None, None]) & beta0[:, None, None, None]
+    surface = right.mean(axis=0)
+    off = _plateau(surface[:, :, 0])
+    best = (*off, 0)
+    if gap:
+        on = _plateau(surface[:, :, 1:])
+        if surface[on[0], on[1], on[2] + 1] > surface[best]:
+            best = (on[0], on[1], on[2] + 1)
+    i, j, k = best
+    th = RatioThresholds(float(Q_GRID[i]), float(TAU_GRID[j]), gamma=float(GAMMA_GRID[k]))
+    return Fit(thresholds=th, accuracy=float(surface[best]), surface=surface)
+
+
+def _plateau(surface: np.ndarray) -> tuple[int, ...]:
+    smooth = uniform_filter(surface, size=3, mode="nearest")
     return tuple(int(x) for x in np.unravel_index(int(np.argmax(smooth + 1e-9 * surface)), surface.shape))
 
 

@@ -1,0 +1,184 @@
+"""Levers the accuracy issue names, measured on the benchmark's tuning cases.
+
+Each variant maps the tuning cases of ``swarmtopo-accuracy/1`` (inside
+``tuning_session``: reporting cases are closed; no L-shaped holes) from logs stripped of
+ground truth, and the ratio classifier (q_1, tau_1, gamma_1) is fitted for each variant
+on its own maps (``experiments.tuning.fit_thresholds``), so a variant is compared at
+its best.  Printed per variant: fitted exact (beta_0, beta_1), the 4-fold
+cross-validated count (thresholds fitted without each quarter), per-cell counts and
+seconds per map.
+
+Variants (all: hybrid metric, maxmin, automatic landmarks, h = r_d / v_c):
+
+* ``default`` -- ``MapConfig()``.
+* ``20s`` -- fixed 20 s windows overlapping by half (the previous default).
+* ``whole`` -- the whole log at once.
+* ``quarter`` -- automatic windows started every quarter window (twice the windows).
+* ``draws`` -- three landmark draws (seeds) per window, all their counts voted.
+* ``switch`` -- a cost per change of agent instead of per hop: every pair of one
+  agent's events joined with its chain time + h (the paper's all-pairs graph plus h:
+  a path pays h once per agent it rides), built literally, O(m^2) per agent.
+* ``witness`` -- lazy witness complex (nu = 1) on the landmarks with every event of the
+  window as a witness, instead of Vietoris-Rips: edge (i, j) enters at
+  min_w max(d(w, l_i), d(w, l_j)) - m_w, m_w the distance of w to its nearest landmark.
+
+Usage::
+
+    python benchmarks/levers.py [--per-cell 12] [--variants default switch ...] [--processes 2]
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+
+from swarmtopo import graph as G
+from swarmtopo import pipeline as P
+from swarmtopo.errors import SwarmtopoError
+from swarmtopo.experiments.accuracy import CELLS, case, tuning_session
+from swarmtopo.experiments.grid import case_streams
+from swarmtopo.experiments.sweep import build_arena, stripped_log
+from swarmtopo.experiments.tuning import TuningMap, exact, fit_thresholds
+from swarmtopo.persistence import rips_persistence
+from swarmtopo.pipeline import WHOLE_LOG, MapConfig, map_encounters, resolve_window
+from swarmtopo.ratio import WindowBars
+from swarmtopo.sim import simulate
+
+
+def _windows_of(log, seed, **options):
+    tmap = map_encounters(log, MapConfig(seed=seed, embed_dim=0, cycles=False, **options))
+    return [[WindowBars(w.diagram, w.scales.cover_radius) for w in r.windows] for r in tmap.regions], tmap.betti[0]
+
+
+def _quarter(log, seed):
+    config = MapConfig()
+    span = float(log.t[-1] - log.t[0])
+    length, _ = resolve_window(log, None, config.window_encounters, span)
+    return _windows_of(log, seed, window_step=length / 4 if np.isfinite(length) else None)
+
+
+def _draws(log, seed, k=3):
+    regions, beta0 = _windows_of(log, seed)
+    for d in range(1, k):
+        more, _ = _windows_of(log, seed + d)
+        regions = [a + b for a, b in zip(regions, more)]
+    return regions, beta0
+
+
+def _switch_graph(log, metric="plain", *, window=None, hop_cost=0.0):
+    """The per-change-of-agent metric: every pair of one agent's events joined with the
+    chain time between them (stops contracted as in the paper) + h."""
+    start, stop = G._window_slice(log, window)
+    t, a, b = log.t[start:stop], log.a[start:stop], log.b[start:stop]
+    pair_agent, first, second = G._agent_chains(a, b)
+    weight = t[second] - t[first]
+    intervals = G._stop_intervals(log, metric)
+    if intervals is not None and len(intervals[0]):
+        weight[G._within_one_interval(pair_agent, t[first], t[second], intervals, log.n_agents)] = 0.0
+    heads = np.flatnonzero(np.r_[True, pair_agent[1:] != pair_agent[:-1], True])
+    u, v, w = [], [], []
+    for lo, hi in zip(heads[:-1], heads[1:]):
+        events = np.r_[first[lo:hi], second[hi - 1]]
+        elapsed = np.r_[0.0, np.cumsum(weight[lo:hi])]
+        i, j = np.triu_indices(len(events), 1)
+        u.append(events[i]), v.append(events[j]), w.append(elapsed[j] - elapsed[i] + hop_cost)
+    return G._contract(t, np.concatenate(u), np.concatenate(v), np.concatenate(w),
+                       np.arange(start, stop, dtype=np.int64), metric)
+
+
+def _switch(log, seed):
+    original = P.build_graph
+    P.build_graph = _switch_graph
+    try:
+        return _windows_of(log, seed)
+    finally:
+        P.build_graph = original
+
+
+def _witness_filtration(to_nodes: np.ndarray) -> np.ndarray:
+    """Lazy witness (nu = 1) edge values from (L, N) landmark-to-node distances."""
+    nearest = to_nodes.min(axis=0)
+    values = np.empty((len(to_nodes), len(to_nodes)))
+    for i, row in enumerate(to_nodes):
+        values[i] = (np.maximum(row[None, :], to_nodes) - nearest[None, :]).min(axis=1)
+    values = np.maximum(np.minimum(values, values.T), 0.0)
+    np.fill_diagonal(values, 0.0)
+    return values
+
+
+def _witness(log, seed):
+    original = P._map_window
+
+    def witness_window(span, sub, n_land, config, rng, timings, say):
+        window = original(span, sub, n_land, config, rng, timings, say)
+        values = _witness_filtration(sub.distances_from(window.landmarks.nodes))
+        return dataclasses.replace(window, persistence=rips_persistence(values, maxdim=config.maxdim))
+
+    P._map_window = witness_window
+    try:
+        return _windows_of(log, seed)
+    finally:
+        P._map_window = original
+
+
+VARIANTS = {
+    "default": lambda log, seed: _windows_of(log, seed),
+    "20s": lambda log, seed: _windows_of(log, seed, window_length=20.0),
+    "whole": lambda log, seed: _windows_of(log, seed, window_length=WHOLE_LOG),
+    "quarter": _quarter,
+    "draws": _draws,
+    "switch": _switch,
+    "witness": _witness,
+}
+
+
+def _run(task):
+    name, cell_index, index = task
+    cell = CELLS[cell_index]
+    with tuning_session():
+        arena_table, seed = case(cell, "tuning", index)
+    streams = case_streams(seed)
+    arena = build_arena(arena_table, streams["arena"])
+    log = stripped_log(simulate(arena, cell.agents, cell.duration, rng=streams["simulation"]).log)
+    start = time.perf_counter()
+    try:
+        regions, beta0 = VARIANTS[name](log, seed % 2**32)
+    except SwarmtopoError:
+        return None, cell.name, time.perf_counter() - start
+    truth = arena.betti
+    return (TuningMap(tuple(tuple(r) for r in regions), beta0, truth[0], truth[1], cell.name), cell.name,
+            time.perf_counter() - start)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--per-cell", type=int, default=12)
+    parser.add_argument("--variants", nargs="+", default=["default", "20s", "whole", "quarter", "draws", "switch"],
+                        choices=sorted(VARIANTS))
+    parser.add_argument("--processes", type=int, default=2)
+    args = parser.parse_args()
+    print(f"tuning cases of {len(CELLS)} cells x {args.per_cell}; per cell: " + ", ".join(c.name for c in CELLS))
+    for name in args.variants:
+        tasks = [(name, c, i) for i in range(args.per_cell) for c in range(len(CELLS))]
+        with ProcessPoolExecutor(args.processes) as pool:
+            results = list(pool.map(_run, tasks))
+        maps = [m for m, _, _ in results if m is not None]
+        fit = fit_thresholds(maps)
+        right = exact(maps, fit.thresholds)
+        fold = np.arange(len(maps)) % 4
+        cv = sum(int(exact([m for m, f in zip(maps, fold) if f == k],
+                           fit_thresholds([m for m, f in zip(maps, fold) if f != k]).thresholds).sum())
+                 for k in range(4))
+        per_cell = [int(sum(ok for m, ok in zip(maps, right) if m.cell == c.name)) for c in CELLS]
+        seconds = np.mean([s for _, _, s in results])
+        th = fit.thresholds
+        print(f"{name}: {int(right.sum())}/{len(tasks)} exact (q {th.q:g}, tau {th.tau:g}, gamma {th.gamma:g}); "
+              f"4-fold CV {cv}/{len(tasks)}; per cell {per_cell}; {seconds:.2f} s per map", flush=True)
+
+
+if __name__ == "__main__":
+    main()
