@@ -72,22 +72,15 @@ def _draws(log, seed, k=3):
 def _switch_graph(log, metric="plain", *, window=None, hop_cost=0.0):
     """The per-change-of-agent metric: every pair of one agent's events joined with the
     chain time between them (stops contracted as in the paper) + h."""
-    start, stop = G._window_slice(log, window)
-    t, a, b = log.t[start:stop], log.a[start:stop], log.b[start:stop]
-    pair_agent, first, second = G._agent_chains(a, b)
-    weight = t[second] - t[first]
-    intervals = G._stop_intervals(log, metric)
-    if intervals is not None and len(intervals[0]):
-        weight[G._within_one_interval(pair_agent, t[first], t[second], intervals, log.n_agents)] = 0.0
-    heads = np.flatnonzero(np.r_[True, pair_agent[1:] != pair_agent[:-1], True])
+    chains = G.chain_edges(log, metric, window)
+    heads = np.flatnonzero(np.r_[True, chains.agent[1:] != chains.agent[:-1], True])
     u, v, w = [], [], []
     for lo, hi in zip(heads[:-1], heads[1:]):
-        events = np.r_[first[lo:hi], second[hi - 1]]
-        elapsed = np.r_[0.0, np.cumsum(weight[lo:hi])]
+        events = np.r_[chains.first[lo:hi], chains.second[hi - 1]]
+        elapsed = np.r_[0.0, np.cumsum(chains.weight[lo:hi])]
         i, j = np.triu_indices(len(events), 1)
         u.append(events[i]), v.append(events[j]), w.append(elapsed[j] - elapsed[i] + hop_cost)
-    return G._contract(t, np.concatenate(u), np.concatenate(v), np.concatenate(w),
-                       np.arange(start, stop, dtype=np.int64), metric)
+    return G._contract(chains.t, np.concatenate(u), np.concatenate(v), np.concatenate(w), chains.event_index, metric)
 
 
 def _switch(log, seed):

@@ -33,7 +33,7 @@ from swarmtopo.experiments.store import read_jobs
 from swarmtopo.experiments.sweep import run_sweep
 from swarmtopo.experiments.tuning import (GAMMA_GRID, Q_GRID, TAU_GRID, calibrated_classifier, exact,
                                          fit_thresholds, maps_from_rows)
-from swarmtopo.pipeline import WHOLE_LOG, MapConfig
+from swarmtopo.pipeline import MapConfig, window_length_option
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -78,7 +78,7 @@ def main() -> None:
             maps = maps_from_rows(candidate_rows, cell_of)
             fit = fit_thresholds(maps)
             right = exact(maps, fit.thresholds)
-            no_gap = int(exact(maps, fit_thresholds(maps, gap=False).thresholds).sum())
+            no_gap = int(exact(maps, fit.no_gap).sum())
             failed = len(candidate_rows) - len(maps)
             per_cell = {c.name: _rate([ok for m, ok in zip(maps, right) if m.cell == c.name]) for c in CELLS}
             paper_form = [r["error"] is None and r["est_betti0"] == r["true_betti0"]
@@ -93,8 +93,7 @@ def main() -> None:
     winner = CANDIDATES[best]
     defaults = MapConfig()
     expected = {"hop_cost": None if winner["hop_cost"] == "auto" else winner["hop_cost"],
-                "window_length": {"auto": None, "none": WHOLE_LOG}.get(winner["window_length"],
-                                                                       winner["window_length"]),
+                "window_length": window_length_option(winner["window_length"]),
                 "window_encounters": winner.get("window_encounters", defaults.window_encounters),
                 "window_step": None if winner.get("window_step", "auto") == "auto" else winner["window_step"]}
     chosen = results[best]
@@ -151,9 +150,11 @@ def _write_doc(results, best, args, seconds, summary, job_minutes) -> None:
                      f"{r['right'] / r['total']:.2f} | {r['no_gap']}/{r['total']} = {r['no_gap'] / r['total']:.2f} | "
                      f"{r['paper_form']}/{r['total']} = {r['paper_form'] / r['total']:.2f} | "
                      f"{worst[0]}: {worst[1][0]}/{worst[1][1]} | {r['seconds']:.2f} |")
-    chosen = results[best]
-    lines += ["", f"Chosen candidate per cell ({best}):", "", "| cell | exact |", "|---|---|"]
-    lines += [f"| {c} | {k}/{n} |" for c, (k, n) in chosen["per_cell"].items()]
+    names = sorted(results, key=lambda n: -results[n]["right"])
+    lines += ["", "Exact maps per cell, every candidate (ratio classifier, its fitted thresholds):", "",
+              "| cell | " + " | ".join(names) + " |", "|---" * (len(names) + 1) + "|"]
+    lines += [f"| {c.name} | " + " | ".join("{}/{}".format(*results[n]["per_cell"][c.name]) for n in names) + " |"
+              for c in CELLS]
     lines.append("")
     (ROOT / "docs" / "tuning.md").write_text("\n".join(lines), encoding="utf-8")
 

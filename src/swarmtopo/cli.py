@@ -216,7 +216,7 @@ def map_command(
     """Map an encounter log folder: Betti numbers with confidence, diagrams and pictures."""
     from .classify import load_classifier
     from .io import read_log
-    from .pipeline import WHOLE_LOG, MapConfig
+    from .pipeline import MapConfig, window_length_option
 
     _check_verbosity(quiet, verbose)
     if paper:
@@ -230,8 +230,7 @@ def map_command(
     log = read_log(log_dir)
     config = MapConfig(metric=metric, subsample=subsample, landmarks=landmarks, window=window, maxdim=maxdim,
                        seed=seed, hop_cost=hop_cost,
-                       window_length={None: None, "auto": None, "none": WHOLE_LOG}.get(window_length)
-                       if window_length in (None, "auto", "none") else float(window_length))
+                       window_length=window_length_option(window_length))
     if verbose:
         _detail(f"log {log_dir}: {log.n_events} encounters of {log.n_agents} agents over {log.duration:g} s")
     tmap, written = _run_map(log, config, log_dir, out_dir, quiet, verbose, classifier=model)

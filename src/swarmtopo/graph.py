@@ -230,6 +230,29 @@ def build_graph(log: EncounterLog, metric: str = "plain", *,
     InputError
         Unknown metric, or no events (in the window).
     """
+    chains = chain_edges(log, metric, window)
+    weight = chains.weight + non_negative("hop cost", hop_cost)
+    return _contract(chains.t, chains.first, chains.second, weight, chains.event_index, metric)
+
+
+@dataclass(frozen=True)
+class ChainEdges:
+    """The chain graph's edges before contraction: consecutive events ``first`` ->
+    ``second`` (indices into the windowed events) of ``agent``, with the metric's weight
+    w^k (0 inside one stop interval), and the windowed events' times and log indices."""
+
+    agent: np.ndarray
+    first: np.ndarray
+    second: np.ndarray
+    weight: np.ndarray
+    t: np.ndarray
+    event_index: np.ndarray
+
+
+def chain_edges(log: EncounterLog, metric: str = "plain",
+                window: tuple[float | None, float | None] | None = None) -> ChainEdges:
+    """Consecutive events of each agent in the (windowed) log and their weights under
+    ``metric`` (no hop cost), grouped by agent in time order; raises as :func:`build_graph`."""
     _check_metric(metric)
     start, stop = _window_slice(log, window)
     t, a, b = log.t[start:stop], log.a[start:stop], log.b[start:stop]
@@ -238,9 +261,7 @@ def build_graph(log: EncounterLog, metric: str = "plain", *,
     intervals = _stop_intervals(log, metric)
     if intervals is not None and len(intervals[0]):
         weight[_within_one_interval(pair_agent, t[first], t[second], intervals, log.n_agents)] = 0.0
-    weight += non_negative("hop cost", hop_cost)
-    event_index = np.arange(start, stop, dtype=np.int64)
-    return _contract(t, first, second, weight, event_index, metric)
+    return ChainEdges(pair_agent, first, second, weight, t, np.arange(start, stop, dtype=np.int64))
 
 
 def agent_gaps(log: EncounterLog) -> np.ndarray:

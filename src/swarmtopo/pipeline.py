@@ -54,6 +54,14 @@ HOP_GAP_FACTOR = 2.0
 between an agent's consecutive encounters (docs/accuracy.md, "Real traces")."""
 WHOLE_LOG = float("inf")
 """``MapConfig.window_length`` that maps the whole log at once (the paper)."""
+
+
+def window_length_option(value: str | float | None) -> float | None:
+    """``MapConfig.window_length`` of a command-line or sweep value: "auto" (or None) ->
+    None (from the data), "none" -> ``WHOLE_LOG``, a number -> that many seconds."""
+    if value is None or value == "auto":
+        return None
+    return WHOLE_LOG if value == "none" else float(value)
 STAGES = ("graph", "landmarks", "persistence", "embedding", "classify", "cycles")
 """Stage names passed to ``map_encounters``'s progress callback, in order."""
 

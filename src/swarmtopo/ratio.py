@@ -144,13 +144,14 @@ def window_margin(diagram: Diagram, dim: int, cover_radius: float, th: RatioThre
     counted = (tests > 0).all(axis=1)
     # a counted bar flips when its weakest test fails; an uncounted one needs every failing test to pass
     flip = np.where(counted, tests.min(axis=1), (-np.minimum(tests, 0)).max(axis=1))
-    finite, order, gaps = ranked_gaps(diagram[dim])
-    ranks = np.flatnonzero(counted[order])
-    if th.gamma <= 0 or not len(ranks):
-        return float(min(MAX_MARGIN, flip.min()))
-    ranked = np.sort(gaps[ranks])[::-1]
-    runner_up = ranked[1] if len(ranked) > 1 else -np.inf
-    return float(min(MAX_MARGIN, ranked[0] - runner_up, ranked[0] - np.log(th.gamma)))
+    if th.gamma > 0:  # with the gap rule: how far the largest gap is from losing its place
+        _, order, gaps = ranked_gaps(diagram[dim])
+        ranks = np.flatnonzero(counted[order])
+        if len(ranks):
+            ranked = np.sort(gaps[ranks])[::-1]
+            runner_up = ranked[1] if len(ranked) > 1 else -np.inf
+            return float(min(MAX_MARGIN, ranked[0] - runner_up, ranked[0] - np.log(th.gamma)))
+    return float(min(MAX_MARGIN, flip.min()))
 
 
 def median_vote(counts: Sequence[int]) -> int:

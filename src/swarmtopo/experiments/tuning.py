@@ -70,6 +70,7 @@ class Fit:
     thresholds: RatioThresholds
     accuracy: float
     surface: np.ndarray  # (len(Q_GRID), len(TAU_GRID), len(GAMMA_GRID)) exact rate
+    no_gap: RatioThresholds  # the best point with the gap rule off (what the gap rule is weighed against)
 
 
 def window_counts(diagram: Diagram) -> np.ndarray:
@@ -88,7 +89,10 @@ def window_counts(diagram: Diagram) -> np.ndarray:
     if not len(ranked):
         return out
     best = np.maximum.accumulate(gaps)
-    first = np.array([int(np.argmax(gaps[:i + 1])) for i in range(len(gaps))])  # k* - 1 over the first i + 1 ranks
+    # k* - 1 over the first i + 1 ranks: the last rank where the running maximum rose
+    # (strictly, so ties keep the first argmax)
+    rose = np.r_[True, gaps[1:] > best[:-1]]
+    first = np.maximum.accumulate(np.where(rose, np.arange(len(gaps)), 0))
     ascending = ranked[::-1]
     log_gamma = np.log(np.maximum(GAMMA_GRID[1:], 1.0))
     for i, q in enumerate(Q_GRID):
@@ -113,25 +117,27 @@ def grid_estimates(maps: Sequence[TuningMap]) -> np.ndarray:
     return est
 
 
-def fit_thresholds(maps: Sequence[TuningMap], gap: bool = True) -> Fit:
+def fit_thresholds(maps: Sequence[TuningMap]) -> Fit:
     """(q_1, tau_1) with the gap rule off, and (q_1, tau_1, gamma_1 >= 1) with it on,
     each at the grid point whose 3 x 3 (x 3) neighbourhood (edges repeated) has the
     highest mean exact rate (ties: the first), so the choice sits inside a plateau
     rather than on a lucky spike; the gap rule is kept only if its point is right on
-    more maps.  ``gap=False``: the gap rule is not considered."""
+    more maps."""
     truth = np.array([m.true_betti1 for m in maps])
     beta0 = np.array([m.est_betti0 == m.true_betti0 for m in maps])
     right = (grid_estimates(maps) == truth[:, None, None, None]) & beta0[:, None, None, None]
     surface = right.mean(axis=0)
-    off = _plateau(surface[:, :, 0])
-    best = (*off, 0)
-    if gap:
-        on = _plateau(surface[:, :, 1:])
-        if surface[on[0], on[1], on[2] + 1] > surface[best]:
-            best = (on[0], on[1], on[2] + 1)
-    i, j, k = best
-    th = RatioThresholds(float(Q_GRID[i]), float(TAU_GRID[j]), gamma=float(GAMMA_GRID[k]))
-    return Fit(thresholds=th, accuracy=float(surface[best]), surface=surface)
+    off = (*_plateau(surface[:, :, 0]), 0)
+    on = _plateau(surface[:, :, 1:])
+    on = (on[0], on[1], on[2] + 1)
+    best = on if surface[on] > surface[off] else off
+    return Fit(thresholds=_thresholds(best), accuracy=float(surface[best]), surface=surface,
+               no_gap=_thresholds(off))
+
+
+def _thresholds(point: tuple[int, int, int]) -> RatioThresholds:
+    i, j, k = point
+    return RatioThresholds(float(Q_GRID[i]), float(TAU_GRID[j]), gamma=float(GAMMA_GRID[k]))
 
 
 def _plateau(surface: np.ndarray) -> tuple[int, ...]:
