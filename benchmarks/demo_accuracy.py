@@ -20,8 +20,10 @@ from swarmtopo.sim import simulate
 
 PIPELINES = {
     "default": (dict(), "default"),
-    "paper form (h = 0, whole log)": (dict(hop_cost=0.0, window_length=WHOLE_LOG), "paper-form"),
-    "--paper (h = 0, whole log, Theta*)": (dict(hop_cost=0.0, window_length=WHOLE_LOG), "paper"),
+    "paper form (h = 0, whole log)": (dict(hop_cost=0.0, diffusion_time=WHOLE_LOG, window_length=WHOLE_LOG),
+                                      "paper-form"),
+    "--paper (h = 0, whole log, Theta*)": (dict(hop_cost=0.0, diffusion_time=WHOLE_LOG, window_length=WHOLE_LOG),
+                                           "paper"),
 }
 
 

@@ -8,7 +8,8 @@ its best.  Printed per variant: fitted exact (beta_0, beta_1), the 4-fold
 cross-validated count (thresholds fitted without each quarter), per-cell counts and
 seconds per map.
 
-Variants (all: hybrid metric, maxmin, automatic landmarks, h = r_d / v_c):
+Variants (all: hybrid metric, maxmin, automatic landmarks, h = r_d / v_c, automatic
+diffusion time):
 
 * ``default`` -- ``MapConfig()``.
 * ``20s`` -- fixed 20 s windows overlapping by half (the previous default).
@@ -16,15 +17,29 @@ Variants (all: hybrid metric, maxmin, automatic landmarks, h = r_d / v_c):
 * ``quarter`` -- automatic windows started every quarter window (twice the windows).
 * ``draws`` -- three landmark draws (seeds) per window, all their counts voted.
 * ``switch`` -- a cost per change of agent instead of per hop: every pair of one
-  agent's events joined with its chain time + h (the paper's all-pairs graph plus h:
-  a path pays h once per agent it rides), built literally, O(m^2) per agent.
+  agent's events joined with D_tau(its chain time) + h (the paper's all-pairs graph plus
+  h: a path pays h once per agent it rides), built literally, O(m^2) per agent.
+* ``geodesic`` -- Vietoris-Rips on geodesic distances of a k-NN graph of the landmarks
+  (k = 10, joined with a minimum spanning tree so it is connected): the Isomap-style
+  re-estimate of the landmark metric from its shortest distances only.
+* ``hop-half``, ``hop-double`` -- half and twice the default hop cost h.
+* ``dense`` -- up to 800 landmarks, covering radius down to 1 x the k-NN scale (the
+  default: 400, 1.5 x).
+* ``diffusive-C`` -- diffusion time tau = C x the mean time between an agent's
+  encounters (the default is C = ``DIFFUSION_GAP_FACTOR``; ``diffusion_time=inf`` is
+  off, the paper's weights); ``switch-C`` the same with ``switch``, where D_tau applies
+  to a whole ride on one agent, not to each gap.
+* ``mds-D`` -- Vietoris-Rips on the landmarks' classical MDS coordinates in R^D (the
+  projection on the top D eigenvectors as a denoiser) instead of their metric.
+* ``FIELD=VALUE`` -- ``MapConfig(FIELD=VALUE)`` (e.g. ``subsample=knn``, ``metric=plain``).
 * ``witness`` -- lazy witness complex (nu = 1) on the landmarks with every event of the
   window as a witness, instead of Vietoris-Rips: edge (i, j) enters at
   min_w max(d(w, l_i), d(w, l_j)) - m_w, m_w the distance of w to its nearest landmark.
 
 Usage::
 
-    python benchmarks/levers.py [--per-cell 12] [--variants default switch ...] [--processes 2]
+    python benchmarks/levers.py [--per-cell 12] [--variants default switch ...] [--cells "200 x 30" ...]
+                                [--processes 2]
 """
 
 from __future__ import annotations
@@ -35,16 +50,19 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
+from scipy import sparse
+from scipy.sparse.csgraph import minimum_spanning_tree, shortest_path
 
 from swarmtopo import graph as G
 from swarmtopo import pipeline as P
+from swarmtopo.embed import mds
 from swarmtopo.errors import SwarmtopoError
 from swarmtopo.experiments.accuracy import CELLS, case, tuning_session
 from swarmtopo.experiments.grid import case_streams
 from swarmtopo.experiments.sweep import build_arena, stripped_log
 from swarmtopo.experiments.tuning import TuningMap, exact, fit_thresholds
 from swarmtopo.persistence import rips_persistence
-from swarmtopo.pipeline import WHOLE_LOG, MapConfig, map_encounters, resolve_window
+from swarmtopo.pipeline import WHOLE_LOG, MapConfig, map_encounters, mean_agent_gap, resolve_window
 from swarmtopo.ratio import WindowBars
 from swarmtopo.sim import simulate
 
@@ -57,7 +75,7 @@ def _windows_of(log, seed, **options):
 def _quarter(log, seed):
     config = MapConfig()
     span = float(log.t[-1] - log.t[0])
-    length, _ = resolve_window(log, None, config.window_encounters, span)
+    length, _ = resolve_window(mean_agent_gap(log), None, config.window_encounters, span)
     return _windows_of(log, seed, window_step=length / 4 if np.isfinite(length) else None)
 
 
@@ -69,9 +87,9 @@ def _draws(log, seed, k=3):
     return regions, beta0
 
 
-def _switch_graph(log, metric="plain", *, window=None, hop_cost=0.0):
-    """The per-change-of-agent metric: every pair of one agent's events joined with the
-    chain time between them (stops contracted as in the paper) + h."""
+def _switch_graph(log, metric="plain", *, window=None, hop_cost=0.0, diffusion_time=np.inf):
+    """The per-change-of-agent metric: every pair of one agent's events joined with
+    D_tau(the chain time between them) (stops contracted as in the paper) + h."""
     chains = G.chain_edges(log, metric, window)
     heads = np.flatnonzero(np.r_[True, chains.agent[1:] != chains.agent[:-1], True])
     u, v, w = [], [], []
@@ -79,15 +97,16 @@ def _switch_graph(log, metric="plain", *, window=None, hop_cost=0.0):
         events = np.r_[chains.first[lo:hi], chains.second[hi - 1]]
         elapsed = np.r_[0.0, np.cumsum(chains.weight[lo:hi])]
         i, j = np.triu_indices(len(events), 1)
-        u.append(events[i]), v.append(events[j]), w.append(elapsed[j] - elapsed[i] + hop_cost)
+        u.append(events[i]), v.append(events[j])
+        w.append(G.diffusive_weight(elapsed[j] - elapsed[i], diffusion_time) + hop_cost)
     return G._contract(chains.t, np.concatenate(u), np.concatenate(v), np.concatenate(w), chains.event_index, metric)
 
 
-def _switch(log, seed):
+def _switch(log, seed, **options):
     original = P.build_graph
     P.build_graph = _switch_graph
     try:
-        return _windows_of(log, seed)
+        return _windows_of(log, seed, **options)
     finally:
         P.build_graph = original
 
@@ -103,19 +122,85 @@ def _witness_filtration(to_nodes: np.ndarray) -> np.ndarray:
     return values
 
 
-def _witness(log, seed):
+def _other_filtration(log, seed, values_of):
+    """Map with Vietoris-Rips on ``values_of(window, sub)`` (an L x L matrix from a
+    window's landmarks and its graph) instead of the landmarks' metric."""
     original = P._map_window
 
-    def witness_window(span, sub, n_land, config, rng, timings, say):
+    def window_with_other_filtration(span, sub, n_land, config, rng, timings, say):
         window = original(span, sub, n_land, config, rng, timings, say)
-        values = _witness_filtration(sub.distances_from(window.landmarks.nodes))
+        values = values_of(window, sub)
         return dataclasses.replace(window, persistence=rips_persistence(values, maxdim=config.maxdim))
 
-    P._map_window = witness_window
+    P._map_window = window_with_other_filtration
     try:
         return _windows_of(log, seed)
     finally:
         P._map_window = original
+
+
+def _witness(log, seed):
+    return _other_filtration(log, seed, lambda window, sub: _witness_filtration(
+        sub.distances_from(window.landmarks.nodes)))
+
+
+def _geodesic_values(distances: np.ndarray, k: int = 10) -> np.ndarray:
+    """Shortest paths among the landmarks over their symmetric k-NN graph joined with a
+    minimum spanning tree of ``distances`` (so every pair is connected)."""
+    n = len(distances)
+    k = min(k, n - 1)
+    rows = np.repeat(np.arange(n), k)
+    cols = np.argsort(distances, axis=1, kind="stable")[:, 1:k + 1].ravel()
+    knn = sparse.csr_matrix((distances[rows, cols], (rows, cols)), shape=(n, n))
+    edges = knn.maximum(knn.T).maximum(minimum_spanning_tree(distances)).tocsr()
+    return shortest_path(edges, method="D", directed=False)
+
+
+def _geodesic(log, seed):
+    return _other_filtration(log, seed, lambda window, sub: _geodesic_values(window.landmarks.distances))
+
+
+def _planar_distances(distances: np.ndarray, dim: int) -> np.ndarray:
+    """Euclidean distances between the landmarks' classical MDS coordinates in R^dim."""
+    points = mds(distances, dim=dim, method="classical").coords
+    return np.sqrt(((points[:, None, :] - points[None, :, :]) ** 2).sum(-1))
+
+
+def _mds(log, seed, dim):
+    return _other_filtration(log, seed, lambda window, sub: _planar_distances(window.landmarks.distances, dim))
+
+
+def _override(text):
+    """The variant ``FIELD=VALUE``: MapConfig(FIELD=VALUE), VALUE read as the field's default's type."""
+    field, value = text.split("=", 1)
+    default = getattr(MapConfig(), field)
+    value = value if isinstance(default, str) else type(default)(float(value)) if default is not None else float(value)
+    return lambda log, seed: _windows_of(log, seed, **{field: value})
+
+
+def _variant(name):
+    if "=" in name:
+        return _override(name)
+    if name.startswith("mds-"):
+        return lambda log, seed: _mds(log, seed, int(name.split("-", 1)[1]))
+    if name.startswith(("diffusive-", "switch-")):
+        mapper = _windows_of if name.startswith("diffusive-") else _switch
+        factor = float(name.split("-", 1)[1])
+        return lambda log, seed: mapper(log, seed, diffusion_time=factor * mean_agent_gap(log))
+    return VARIANTS[name]
+
+
+def _hop_times(factor):
+    return lambda log, seed: _windows_of(log, seed, hop_cost=factor * P.resolve_hop_cost(log, None)[0])
+
+
+def _dense(log, seed):
+    original = P.AUTO_COVER_FACTOR
+    P.AUTO_COVER_FACTOR = 1.0
+    try:
+        return _windows_of(log, seed, max_landmarks=800)
+    finally:
+        P.AUTO_COVER_FACTOR = original
 
 
 VARIANTS = {
@@ -126,6 +211,10 @@ VARIANTS = {
     "draws": _draws,
     "switch": _switch,
     "witness": _witness,
+    "geodesic": _geodesic,
+    "hop-half": _hop_times(0.5),
+    "hop-double": _hop_times(2.0),
+    "dense": _dense,
 }
 
 
@@ -139,7 +228,7 @@ def _run(task):
     log = stripped_log(simulate(arena, cell.agents, cell.duration, rng=streams["simulation"]).log)
     start = time.perf_counter()
     try:
-        regions, beta0 = VARIANTS[name](log, seed % 2**32)
+        regions, beta0 = _variant(name)(log, seed % 2**32)
     except SwarmtopoError:
         return None, cell.name, time.perf_counter() - start
     truth = arena.betti
@@ -151,12 +240,18 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--per-cell", type=int, default=12)
     parser.add_argument("--variants", nargs="+", default=["default", "20s", "whole", "quarter", "draws", "switch"],
-                        choices=sorted(VARIANTS))
+                        help=f"{', '.join(sorted(VARIANTS))}, diffusive-C, switch-C, mds-D or FIELD=VALUE")
+    parser.add_argument("--cells", nargs="+", metavar="TEXT",
+                        help="only the cells whose name contains one of these (default: all)")
     parser.add_argument("--processes", type=int, default=2)
     args = parser.parse_args()
-    print(f"tuning cases of {len(CELLS)} cells x {args.per_cell}; per cell: " + ", ".join(c.name for c in CELLS))
+    cells = [i for i, c in enumerate(CELLS) if not args.cells or any(text in c.name for text in args.cells)]
+    if args.per_cell * len(cells) < 4:
+        parser.error(f"{args.per_cell * len(cells)} map(s) per variant: the 4-fold cross-validation needs at least 4")
+    print(f"tuning cases of {len(cells)} cells x {args.per_cell}; per cell: "
+          + ", ".join(CELLS[c].name for c in cells))
     for name in args.variants:
-        tasks = [(name, c, i) for i in range(args.per_cell) for c in range(len(CELLS))]
+        tasks = [(name, c, i) for i in range(args.per_cell) for c in cells]
         with ProcessPoolExecutor(args.processes) as pool:
             results = list(pool.map(_run, tasks))
         maps = [m for m, _, _ in results if m is not None]
@@ -166,7 +261,7 @@ def main() -> None:
         cv = sum(int(exact([m for m, f in zip(maps, fold) if f == k],
                            fit_thresholds([m for m, f in zip(maps, fold) if f != k]).thresholds).sum())
                  for k in range(4))
-        per_cell = [int(sum(ok for m, ok in zip(maps, right) if m.cell == c.name)) for c in CELLS]
+        per_cell = [int(sum(ok for m, ok in zip(maps, right) if m.cell == CELLS[c].name)) for c in cells]
         seconds = np.mean([s for _, _, s in results])
         th = fit.thresholds
         print(f"{name}: {int(right.sum())}/{len(tasks)} exact (q {th.q:g}, tau {th.tau:g}, gamma {th.gamma:g}); "

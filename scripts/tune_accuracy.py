@@ -33,26 +33,27 @@ from swarmtopo.experiments.store import read_jobs
 from swarmtopo.experiments.sweep import run_sweep
 from swarmtopo.experiments.tuning import (GAMMA_GRID, Q_GRID, TAU_GRID, calibrated_classifier, exact,
                                          fit_thresholds, maps_from_rows)
-from swarmtopo.pipeline import MapConfig, window_length_option
+from swarmtopo.pipeline import MapConfig, seconds_option
 
 ROOT = Path(__file__).resolve().parent.parent
 
 CANDIDATES = {
-    "h auto, windows of 20 encounters per agent": {"hop_cost": "auto", "window_length": "auto",
-                                                   "window_encounters": 20.0, "window_step": "auto"},
-    "h auto, windows of 25 encounters per agent": {"hop_cost": "auto", "window_length": "auto",
-                                                   "window_encounters": 25.0, "window_step": "auto"},
-    "h auto, windows of 30 encounters per agent": {"hop_cost": "auto", "window_length": "auto",
-                                                   "window_encounters": 30.0, "window_step": "auto"},
-    "h auto, 20 s windows overlapping by half": {"hop_cost": "auto", "window_length": 20.0, "window_step": "auto"},
-    "h auto, whole log": {"hop_cost": "auto", "window_length": "none"},
-    "h 0 (paper), windows of 25 encounters per agent": {"hop_cost": 0.0, "window_length": "auto",
-                                                        "window_encounters": 25.0, "window_step": "auto"},
-    "h 0 (paper), whole log": {"hop_cost": 0.0, "window_length": "none"},
+    **{f"h auto, diffusive, windows of {k} encounters per agent": {
+        "hop_cost": "auto", "diffusion_time": "auto", "window_length": "auto", "window_encounters": float(k),
+        "window_step": "auto"} for k in (20, 25, 30)},
+    "h auto, windows of 25 encounters per agent (no diffusive weights)": {
+        "hop_cost": "auto", "diffusion_time": "none", "window_length": "auto", "window_encounters": 25.0,
+        "window_step": "auto"},
+    "h 0, no diffusive weights, whole log (the paper's metric)": {
+        "hop_cost": 0.0, "diffusion_time": "none", "window_length": "none"},
 }
 """Candidate pipelines (hybrid metric, maxmin, automatic landmarks); "auto" h is
-r_d / v_c = 2 s for the simulated swarms.  Windows of K encounters per agent are K
-times the mean time between an agent's encounters long (``MapConfig.window_encounters``)."""
+r_d / v_c = 2 s for the simulated swarms; "diffusive" is the automatic diffusion time
+(``DIFFUSION_GAP_FACTOR`` x the mean time between an agent's encounters; the factor was
+chosen on tuning cases with ``benchmarks/levers.py``).  Windows of K encounters per
+agent are K times the mean time between an agent's encounters long
+(``MapConfig.window_encounters``).  Candidates measured in earlier rounds (fixed 20 s
+windows, the whole log with h, h = 0 with windows) are in docs/tuning.md's history."""
 
 
 def main() -> None:
@@ -93,7 +94,8 @@ def main() -> None:
     winner = CANDIDATES[best]
     defaults = MapConfig()
     expected = {"hop_cost": None if winner["hop_cost"] == "auto" else winner["hop_cost"],
-                "window_length": window_length_option(winner["window_length"]),
+                "diffusion_time": seconds_option(winner["diffusion_time"]),
+                "window_length": seconds_option(winner["window_length"]),
                 "window_encounters": winner.get("window_encounters", defaults.window_encounters),
                 "window_step": None if winner.get("window_step", "auto") == "auto" else winner["window_step"]}
     chosen = results[best]

@@ -1,5 +1,6 @@
 """Encounter graph: hand-computed metrics, agreement with the literal definition, scale."""
 
+import math
 import tracemalloc
 
 import networkx as nx
@@ -406,10 +407,11 @@ def test_hop_cost_hand_computed_on_the_chain_graph():
     np.testing.assert_array_equal(event_distances(graph), expected)
 
 
-def chain_distances_with_hop_cost(log: EncounterLog, metric: str, h: float) -> np.ndarray:
+def chain_distances_with_hop_cost(log: EncounterLog, metric: str, h: float, tau: float = INF) -> np.ndarray:
     """Literal chain metric with per-hop cost: each agent's events in time order, joined
-    consecutively by the paper's weight (0 inside one stop interval of that agent, read
-    off the status rows as in networkx_distances) plus h."""
+    consecutively by the paper's weight w (0 inside one stop interval of that agent, read
+    off the status rows as in networkx_distances), made diffusive, tau (sqrt(1 + 2 w / tau)
+    - 1), unless tau is inf, plus h."""
     stops = stops_from_status_rows(log) if metric != "plain" else {}
     if metric == "hybrid":
         for agent, time in zip(log.static_agent, log.static_time):
@@ -422,7 +424,8 @@ def chain_distances_with_hop_cost(log: EncounterLog, metric: str, h: float) -> n
         for i, j in zip(members, members[1:]):
             ti, tj = float(log.t[i]), float(log.t[j])
             still = any(s <= ti <= e and s <= tj <= e for s, e in stops.get(k, []))
-            w = (0.0 if still else tj - ti) + h
+            w = 0.0 if still else tj - ti
+            w = (w if tau == INF else tau * (math.sqrt(1 + 2 * w / tau) - 1)) + h
             if not g.has_edge(i, j) or g[i][j]["weight"] > w:
                 g.add_edge(i, j, weight=w)
     out = np.full((log.n_events, log.n_events), INF)
@@ -433,11 +436,34 @@ def chain_distances_with_hop_cost(log: EncounterLog, metric: str, h: float) -> n
 
 
 @settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(log=small_logs(), h=st.sampled_from([0.5, 2.0]), metric=st.sampled_from(METRICS))
-def test_hop_cost_graph_equals_literal_chain(log, h, metric):
-    graph = build_graph(log, metric, hop_cost=h)
-    np.testing.assert_allclose(event_distances(graph), chain_distances_with_hop_cost(log, metric, h),
-                               rtol=0, atol=1e-9)
+@given(log=small_logs(), h=st.sampled_from([0.5, 2.0]), tau=st.sampled_from([INF, 0.7, 3.0]),
+       metric=st.sampled_from(METRICS))
+def test_hop_cost_graph_equals_literal_chain(log, h, tau, metric):
+    graph = build_graph(log, metric, hop_cost=h, diffusion_time=tau)
+    distances = event_distances(graph)
+    np.testing.assert_allclose(distances, chain_distances_with_hop_cost(log, metric, h, tau), rtol=0, atol=1e-9)
+    # D_tau(w) <= w: diffusive weights never lengthen a path
+    assert (distances <= event_distances(build_graph(log, metric, hop_cost=h)) + 1e-9).all()
+
+
+def test_diffusive_weights_hand_computed():
+    # The log of the hop-cost test, plain metric, h = 0, tau = 4: D(w) = 4 (sqrt(1 + w / 2) - 1),
+    # so agent 0's gap e0-e3 of 6 s weighs D(6) = 4 and agent 2's e0-e1, e1-e2, e2-e3 of
+    # 1, 3, 2 s weigh D(1) + D(3) + D(2) = 4.88 > 4: the single long gap is now the shorter
+    # way (at tau = inf both are 6 s).  d(e0, e4) = D(1) + D(6) via agent 1's 6 s gap e1-e4.
+    def d(w):
+        return 4.0 * (math.sqrt(1.0 + w / 2.0) - 1.0)
+
+    distances = event_distances(build_graph(stop_and_static_log(), "plain", diffusion_time=4.0))
+    assert distances[0, 3] == pytest.approx(4.0) and d(1) + d(3) + d(2) == pytest.approx(4.8804, abs=1e-4)
+    assert distances[0, 4] == pytest.approx(d(1) + 4.0)
+    assert event_distances(build_graph(stop_and_static_log(), "plain"))[0, 3] == 6.0
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, float("nan"), "two"])
+def test_bad_diffusion_time_is_an_input_error(bad):
+    with pytest.raises(InputError, match="diffusion time"):
+        build_graph(stop_and_static_log(), "plain", diffusion_time=bad)
 
 
 @pytest.mark.parametrize("bad", [-1.0, float("nan"), float("inf"), "two"])

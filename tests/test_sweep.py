@@ -86,7 +86,8 @@ def test_grid_is_the_product_of_lists_times_replicates_with_defaults():
         "arena": {"generator": "random", "holes": job.config["arena"]["holes"], "shapes": ["square"],
                   "outer": "square", "scale": 1.0},
         "swarm": {"agents": job.config["swarm"]["agents"], "duration": 20.0, "static_fraction": 0.0},
-        "map": {"metric": "hybrid", "hop_cost": "auto", "window_length": "auto", "window_encounters": 25.0,
+        "map": {"metric": "hybrid", "hop_cost": "auto", "diffusion_time": "auto", "window_length": "auto",
+                "window_encounters": 25.0,
                 "window_step": "auto", "subsample": "maxmin", "landmarks": "auto", "max_landmarks": 400, "maxdim": 1, "classifier": "default"},
     }
     # max_landmarks only caps "auto": a fixed L drops it
@@ -161,6 +162,7 @@ def test_keys_are_the_same_in_another_process():
     ("[map]\nmetric = 'hybird'", ['[map] metric = "hybird"', "plain, contracted, hybrid"]),
     ("[map]\nlandmarks = 100\nmax_landmarks = 500", ["[map] max_landmarks", "landmarks is a number"]),
     ("[map]\nhop_cost = -2", ["[map] hop_cost = -2", '>= 0 or "auto"']),
+    ("[map]\ndiffusion_time = 0", ["[map] diffusion_time = 0", '> 0 or "auto" or "none"']),
     ("[map]\nwindow_length = 'all'", ['[map] window_length = "all"', '> 0 or "auto" or "none"']),
     ("[map]\nwindow_length = 20\nwindow_encounters = 30", ["[map] window_encounters", 'window_length is not "auto"']),
     ("[map]\nwindow_encounters = 0", ["[map] window_encounters = 0", "> 0"]),
@@ -193,7 +195,8 @@ def test_cli_bad_config_is_one_line_exit_1(tmp_path):
     proc = run_cli("sweep", path, "--store", tmp_path / "r.duckdb")
     assert proc.returncode == 1 and "Traceback" not in proc.stderr
     assert proc.stderr.strip().splitlines() == [f"error: {path}: [map] metrc: unknown key; expected one of "
-                                                "metric, hop_cost, window_length, window_encounters, window_step, "
+                                                "metric, hop_cost, diffusion_time, window_length, window_encounters, "
+                                                "window_step, "
                                                 "subsample, landmarks, "
                                                 "max_landmarks, maxdim, classifier"]
     assert not (tmp_path / "r.duckdb").exists()

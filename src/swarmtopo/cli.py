@@ -169,7 +169,8 @@ def _parse_window(text: Optional[str]):
     return tuple(None if e is None or math.isinf(e) else e for e in ends)
 
 
-def _parse_window_length(text: Optional[str]):
+def _parse_seconds(text: Optional[str]):
+    """A --window-length or --diffusion-time value: 'auto', 'none' or seconds > 0."""
     if text is None or text in ("auto", "none"):
         return text
     try:
@@ -177,7 +178,7 @@ def _parse_window_length(text: Optional[str]):
     except ValueError:
         raise typer.BadParameter(f"{text!r} is not a number of seconds, 'auto' or 'none'") from None
     if not (math.isfinite(value) and value > 0):
-        raise typer.BadParameter(f"{text!r}: the window length must be a positive number of seconds")
+        raise typer.BadParameter(f"{text!r} must be a positive number of seconds")
     return text
 
 
@@ -199,8 +200,13 @@ def map_command(
         None, "--hop-cost", min=0.0,
         help="Per-hop cost h in seconds on the encounter graph; 0 = the paper's metric "
              "(default: r_d / v_c from meta.json, else from the data)."),
+    diffusion_time: Optional[str] = typer.Option(
+        None, "--diffusion-time", callback=_parse_seconds,
+        help="tau in seconds: a gap of w s between an agent's encounters weighs tau (sqrt(1 + 2 w / tau) - 1), "
+             "about a random walk's displacement; 'none' = the paper's weight w; 'auto' (default) = half the mean "
+             "time between an agent's encounters."),
     window_length: Optional[str] = typer.Option(
-        None, "--window-length", callback=_parse_window_length,
+        None, "--window-length", callback=_parse_seconds,
         help="Seconds of the time windows whose maps vote; 'none' maps the whole log at once; 'auto' (default) "
              "holds about 25 encounters per agent (25 x the mean time between an agent's encounters)."),
     classifier: Optional[str] = typer.Option(
@@ -209,28 +215,30 @@ def map_command(
              "our way), paper (the paper's Theta*), or a JSON file."),
     paper: bool = typer.Option(
         False, "--paper",
-        help="Run exactly the paper's pipeline: no per-hop cost, the whole log, the paper's Theta*."),
+        help="Run exactly the paper's pipeline: no per-hop cost, no diffusive weights, the whole log, the "
+             "paper's Theta*."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
     """Map an encounter log folder: Betti numbers with confidence, diagrams and pictures."""
     from .classify import load_classifier
     from .io import read_log
-    from .pipeline import MapConfig, window_length_option
+    from .pipeline import MapConfig, seconds_option
 
     _check_verbosity(quiet, verbose)
     if paper:
-        given = [name for name, value in (("--hop-cost", hop_cost), ("--window-length", window_length),
-                                          ("--classifier", classifier)) if value is not None]
+        given = [name for name, value in (("--hop-cost", hop_cost), ("--diffusion-time", diffusion_time),
+                                          ("--window-length", window_length), ("--classifier", classifier))
+                 if value is not None]
         if given:
             raise typer.BadParameter(f"--paper fixes {', '.join(given)}; drop one or the other")
-        hop_cost, window_length, classifier = 0.0, "none", "paper"
+        hop_cost, diffusion_time, window_length, classifier = 0.0, "none", "none", "paper"
     out_dir = out_dir or log_dir / "map"
     model = load_classifier(classifier or "default")
     log = read_log(log_dir)
     config = MapConfig(metric=metric, subsample=subsample, landmarks=landmarks, window=window, maxdim=maxdim,
-                       seed=seed, hop_cost=hop_cost,
-                       window_length=window_length_option(window_length))
+                       seed=seed, hop_cost=hop_cost, diffusion_time=seconds_option(diffusion_time),
+                       window_length=seconds_option(window_length))
     if verbose:
         _detail(f"log {log_dir}: {log.n_events} encounters of {log.n_agents} agents over {log.duration:g} s")
     tmap, written = _run_map(log, config, log_dir, out_dir, quiet, verbose, classifier=model)
@@ -509,7 +517,8 @@ def _map_details(tmap) -> None:
             _detail(f"region {r.component}: {len(r.windows)} windows of {tmap.window_length[0]:.3g} s counted "
                     f"{[w.betti.get(1) for w in r.windows]} holes; vote {r.betti.get(1)}, shown: window "
                     f"{r.window} [{r.windows[r.window].t0:.1f}, {r.windows[r.window].t1:.1f}] s")
-    _detail(f"per-hop cost h = {tmap.hop_cost[0]:.3g} s ({tmap.hop_cost[1]}); window "
+    _detail(f"per-hop cost h = {tmap.hop_cost[0]:.3g} s ({tmap.hop_cost[1]}); diffusion time "
+            f"{tmap.diffusion_time[0]:.3g} s ({tmap.diffusion_time[1]}); window "
             f"{tmap.window_length[0]:.3g} s ({tmap.window_length[1]})")
 
 

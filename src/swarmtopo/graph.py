@@ -65,6 +65,22 @@ swarm, distances shrink into noisy hop counts.  This metric lives on the chain g
 C: it is *not* the paper's all-pairs graph G with h added to every edge (there a path
 pays one h for skipping many events).
 
+Diffusive gaps (swarmtopo's variant, not the paper's)
+-----------------------------------------------------
+With ``diffusion_time`` tau < inf every chain edge's weight w = w^k_{e_p e_{p+1}} is
+replaced by
+
+    D_tau(w) = tau (sqrt(1 + 2 w / tau) - 1)      (w for w << tau, sqrt(2 tau w) for w >> tau)
+
+before h is added.  D_tau is increasing, concave, D_tau(0) = 0 and D_tau -> w as tau ->
+inf (the paper's weight).  A long gap between two encounters of one agent is the
+least informative part of a path -- a walker that met no one for w seconds is
+somewhere within reach of v_c w, and on average much closer: a random walk's
+displacement grows like sqrt(w) -- so D_tau charges it about its typical
+displacement, not its duration.  D_tau is subadditive, so it applies to the chain's
+consecutive gaps: the claim above does not carry over, and this metric, like the
+per-hop cost, lives on the chain graph C.
+
 Zero weights and merged nodes
 -----------------------------
 Zero-weight chain edges (stop intervals, static agents, equal times) are contracted
@@ -87,7 +103,7 @@ import scipy.sparse as sp
 from numba import njit
 from scipy.sparse.csgraph import connected_components, csgraph_from_dense, dijkstra
 
-from ._validate import non_negative
+from ._validate import non_negative, positive
 from .errors import InputError
 from .log import EncounterLog
 
@@ -201,7 +217,7 @@ class EncounterGraph:
 
 def build_graph(log: EncounterLog, metric: str = "plain", *,
                 window: tuple[float | None, float | None] | None = None,
-                hop_cost: float = 0.0) -> EncounterGraph:
+                hop_cost: float = 0.0, diffusion_time: float = np.inf) -> EncounterGraph:
     """Sparse chain graph of the events of ``log`` under an encounter metric.
 
     Parameters
@@ -218,6 +234,9 @@ def build_graph(log: EncounterLog, metric: str = "plain", *,
     hop_cost
         h >= 0, seconds, added to every chain edge (see "Per-hop cost" in the module
         docstring); 0 (default) is the paper's metric.
+    diffusion_time
+        tau > 0, seconds: chain gaps w weigh D_tau(w) (see "Diffusive gaps" in the module
+        docstring); inf (default) is the paper's weight w.
 
     Returns
     -------
@@ -228,11 +247,21 @@ def build_graph(log: EncounterLog, metric: str = "plain", *,
     Raises
     ------
     InputError
-        Unknown metric, or no events (in the window).
+        Unknown metric, no events (in the window), a negative hop cost or a diffusion
+        time that is not > 0.
     """
     chains = chain_edges(log, metric, window)
-    weight = chains.weight + non_negative("hop cost", hop_cost)
+    weight = diffusive_weight(chains.weight, diffusion_time) + non_negative("hop cost", hop_cost)
     return _contract(chains.t, chains.first, chains.second, weight, chains.event_index, metric)
+
+
+def diffusive_weight(weight: np.ndarray, diffusion_time: float) -> np.ndarray:
+    """D_tau(w) = tau (sqrt(1 + 2 w / tau) - 1) of chain gaps w (module docstring);
+    ``weight`` itself for tau = inf."""
+    tau = positive("diffusion time", diffusion_time, allow_inf=True)
+    if np.isinf(tau):
+        return weight
+    return tau * (np.sqrt(1.0 + 2.0 * weight / tau) - 1.0)
 
 
 @dataclass(frozen=True)

@@ -52,16 +52,22 @@ ADVICE_BELOW = 0.8
 HOP_GAP_FACTOR = 2.0
 """Without r_d and v_c in meta.json, the per-hop cost h is this many times the mean time
 between an agent's consecutive encounters (docs/accuracy.md, "Real traces")."""
+DIFFUSION_GAP_FACTOR = 0.5
+"""The automatic diffusion time tau is this many times the mean time between an agent's
+consecutive encounters (docs/tuning.md)."""
 WHOLE_LOG = float("inf")
 """``MapConfig.window_length`` that maps the whole log at once (the paper)."""
 
 
-def window_length_option(value: str | float | None) -> float | None:
-    """``MapConfig.window_length`` of a command-line or sweep value: "auto" (or None) ->
-    None (from the data), "none" -> ``WHOLE_LOG``, a number -> that many seconds."""
+def seconds_option(value: str | float | None) -> float | None:
+    """``MapConfig.window_length`` or ``diffusion_time`` of a command-line or sweep value:
+    "auto" (or None) -> None (from the data), "none" -> inf (``WHOLE_LOG``; no diffusive
+    weights), a number -> that many seconds."""
     if value is None or value == "auto":
         return None
     return WHOLE_LOG if value == "none" else float(value)
+
+
 STAGES = ("graph", "landmarks", "persistence", "embedding", "classify", "cycles")
 """Stage names passed to ``map_encounters``'s progress callback, in order."""
 
@@ -81,6 +87,12 @@ class MapConfig:
         (:mod:`swarmtopo.graph`); 0 is the paper's metric; None (default) takes
         r_d / v_c from the log's meta.json, or, for a trace without them,
         ``HOP_GAP_FACTOR`` x the mean time between an agent's encounters.
+    diffusion_time
+        tau (seconds) of the diffusive chain weights D_tau(w) = tau (sqrt(1 + 2 w / tau)
+        - 1) (:mod:`swarmtopo.graph`): a long gap between an agent's encounters costs
+        about a random walk's displacement, not its duration.  inf is the paper's
+        weight; None (default) is ``DIFFUSION_GAP_FACTOR`` x the mean time between an
+        agent's consecutive encounters in the mapped events (:func:`resolve_diffusion_time`).
     window_length
         Length (s) of the time windows each region is mapped in; the region's Betti
         numbers are voted across them (:func:`swarmtopo.ratio.vote`).  None (default):
@@ -131,6 +143,7 @@ class MapConfig:
 
     metric: str = "hybrid"
     hop_cost: float | None = None
+    diffusion_time: float | None = None
     window_length: float | None = None
     window_encounters: float = 25.0
     window_step: float | None = None
@@ -159,6 +172,9 @@ class MapConfig:
             raise SwarmtopoError(f"max_landmarks must be at least 3, got {self.max_landmarks}")
         if self.hop_cost is not None and not (np.isfinite(self.hop_cost) and self.hop_cost >= 0):
             raise SwarmtopoError(f"hop_cost must be a number of seconds >= 0, got {self.hop_cost}")
+        if self.diffusion_time is not None and not self.diffusion_time > 0:
+            raise SwarmtopoError(f"diffusion_time must be a positive number of seconds or inf, got "
+                                 f"{self.diffusion_time}")
         if self.window_length is not None and not self.window_length > 0:
             raise SwarmtopoError(f"window_length must be a positive number of seconds, got {self.window_length}")
         if not (np.isfinite(self.window_encounters) and self.window_encounters > 0):
@@ -251,6 +267,7 @@ class TopologicalMap:
     n_events: int
     n_agents: int
     hop_cost: tuple[float, str] = (0.0, "given")  # (h used, where it came from)
+    diffusion_time: tuple[float, str] = (WHOLE_LOG, "given")  # (tau used, where it came from)
     window_length: tuple[float, str] = (WHOLE_LOG, "given")  # (window length used, where it came from)
     software: dict[str, str] = field(default_factory=dict)
 
@@ -309,6 +326,8 @@ class TopologicalMap:
             "too_little_data": self.too_little_data,
             "params": {**jsonable(asdict(self.config)), "hop_cost_used": self.hop_cost[0],
                        "hop_cost_source": self.hop_cost[1],
+                       "diffusion_time_used": self.diffusion_time[0] if np.isfinite(self.diffusion_time[0]) else None,
+                       "diffusion_time_source": self.diffusion_time[1],
                        "window_length_used": self.window_length[0] if np.isfinite(self.window_length[0]) else None,
                        "window_source": self.window_length[1]},
             "log": {"events": self.n_events, "agents": self.n_agents},
@@ -356,7 +375,10 @@ def map_encounters(
     say("graph")
     t0 = time.perf_counter()
     hop_cost, hop_source = resolve_hop_cost(log, config.hop_cost)
-    graph = build_graph(log, config.metric, window=config.window, hop_cost=hop_cost)
+    mapped = log if config.window is None else log.window(*config.window)
+    agent_gap = mean_agent_gap(mapped)
+    diffusion_time, diffusion_source = resolve_diffusion_time(agent_gap, config.diffusion_time)
+    graph = build_graph(log, config.metric, window=config.window, hop_cost=hop_cost, diffusion_time=diffusion_time)
     n_comp, labels = graph.components()
     event_comp = labels[graph.node_of_event]
     events_per_comp = np.bincount(event_comp, minlength=n_comp)
@@ -373,8 +395,7 @@ def map_encounters(
 
     shares = (_share_landmarks(config.landmarks, events_per_comp[regions_idx]) if config.landmarks
               else [None] * len(regions_idx))
-    mapped = log if config.window is None else log.window(*config.window)
-    window_length, window_source = resolve_window(mapped, config.window_length, config.window_encounters,
+    window_length, window_source = resolve_window(agent_gap, config.window_length, config.window_encounters,
                                                   float(graph.event_t.max() - graph.event_t.min()))
     spans = _windows(graph.event_t, window_length, config.window_step)
     window_graphs = [(None, graph, labels)]  # (span, graph, component labels) of each window
@@ -382,7 +403,8 @@ def map_encounters(
         window_graphs = []
         for span in spans:
             if _events_within(log, span) >= config.min_region_events:  # a gap in a real trace is skipped
-                wgraph = build_graph(log, config.metric, window=span, hop_cost=hop_cost)
+                wgraph = build_graph(log, config.metric, window=span, hop_cost=hop_cost,
+                                     diffusion_time=diffusion_time)
                 window_graphs.append((span, wgraph, wgraph.components()[1]))
     regions: list[RegionMap] = []
     for comp, n_land in zip(regions_idx, shares):
@@ -458,6 +480,7 @@ def map_encounters(
         n_events=graph.n_events,
         n_agents=log.n_agents,
         hop_cost=(hop_cost, hop_source),
+        diffusion_time=(diffusion_time, diffusion_source),
         window_length=(window_length, window_source),
         software=software_versions(),
     )
@@ -495,21 +518,33 @@ def resolve_hop_cost(log: EncounterLog, hop_cost: float | None) -> tuple[float, 
     r_d, v_c = log.meta.get("r_d"), log.meta.get("v_c")
     if all(isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) and x > 0 for x in (r_d, v_c)):
         return float(r_d) / float(v_c), "r_d / v_c from meta.json"
-    gap = _mean_agent_gap(log)
+    gap = mean_agent_gap(log)
     if gap is None:
         return 0.0, "no agent met twice at different times: 0"
     return HOP_GAP_FACTOR * gap, f"{HOP_GAP_FACTOR:g} x mean time between an agent's encounters"
 
 
-def resolve_window(log: EncounterLog, window_length: float | None, encounters: float,
+def resolve_diffusion_time(gap: float | None, diffusion_time: float | None) -> tuple[float, str]:
+    """(tau used, where it came from): the given value, else ``DIFFUSION_GAP_FACTOR`` x
+    ``gap``, the mean time between an agent's consecutive encounters in the mapped events
+    (:func:`mean_agent_gap`); inf (the paper's weights) when no agent met twice at
+    different times (``gap`` None)."""
+    if diffusion_time is not None:
+        return float(diffusion_time), "given"
+    if gap is None:
+        return WHOLE_LOG, "no agent met twice at different times: none"
+    return DIFFUSION_GAP_FACTOR * gap, f"{DIFFUSION_GAP_FACTOR:g} x mean time between an agent's encounters"
+
+
+def resolve_window(gap: float | None, window_length: float | None, encounters: float,
                    span: float) -> tuple[float, str]:
-    """(window length W used, where it came from): the given length, else W = K x the
-    mean time between an agent's consecutive encounters in ``log`` (the mapped events; K =
-    ``encounters``), so a window holds about K encounters per agent; ``WHOLE_LOG`` when
-    W is not shorter than ``span``, the seconds the mapped events cover."""
+    """(window length W used, where it came from): the given length, else W = K x ``gap``,
+    the mean time between an agent's consecutive encounters in the mapped events
+    (:func:`mean_agent_gap`; K = ``encounters``), so a window holds about K encounters per
+    agent; ``WHOLE_LOG`` when W is not shorter than ``span``, the seconds the mapped
+    events cover, or when no agent met twice at different times (``gap`` None)."""
     if window_length is not None:
         return (float(window_length) if window_length < span else WHOLE_LOG), "given"
-    gap = _mean_agent_gap(log)
     if gap is None:
         return WHOLE_LOG, "no agent met twice at different times: the whole log"
     length = encounters * gap
@@ -517,7 +552,7 @@ def resolve_window(log: EncounterLog, window_length: float | None, encounters: f
     return (length, source) if length < span else (WHOLE_LOG, source + " (longer than the log: the whole log)")
 
 
-def _mean_agent_gap(log: EncounterLog) -> float | None:
+def mean_agent_gap(log: EncounterLog) -> float | None:
     """Mean time between an agent's consecutive encounters at different times (None: none)."""
     gaps = agent_gaps(log)
     gaps = gaps[gaps > 0]

@@ -26,6 +26,8 @@ Format (``examples/sweep-small.toml`` is a commented example)::
     [map]
     metric = "hybrid"         # plain | contracted | hybrid (default hybrid)
     hop_cost = "auto"         # per-hop cost h, s: a number >= 0 (0 = the paper) or "auto" (default)
+    diffusion_time = "auto"   # tau of the diffusive chain weights, s: a number > 0, "auto" (default:
+                              # half the mean time between an agent's encounters) or "none" (the paper)
     window_length = "auto"    # windows voted over, s: a number > 0, "auto" (default: window_encounters
                               # encounters per agent) or "none" (whole log, the paper)
     window_encounters = 25.0  # K of automatic windows (only with window_length = "auto")
@@ -188,6 +190,7 @@ PARAMS: tuple[Param, ...] = (
     Param("swarm", "static_time", 0.0, _number(0.0, strict=False), "DOUBLE"),
     Param("map", "metric", "hybrid", _choice(METRICS), "TEXT"),
     Param("map", "hop_cost", "auto", _or_word("auto", _number(0.0, strict=False)), "DOUBLE"),
+    Param("map", "diffusion_time", "auto", _or_word(("auto", "none"), _number(0.0, strict=True)), "DOUBLE"),
     Param("map", "window_length", "auto", _or_word(("auto", "none"), _number(0.0, strict=True)), "DOUBLE"),
     Param("map", "window_encounters", MapConfig().window_encounters, _number(0.0, strict=True), "DOUBLE"),
     Param("map", "window_step", "auto", _or_word("auto", _number(0.0, strict=True)), "DOUBLE"),
@@ -380,12 +383,13 @@ def expand_grid(document: dict, *, source: str = "<grid>", base_dir=None,
 
 def flat_columns(config: dict) -> dict[str, Any]:
     """One value per ``PARAMS`` key (None where the config does not use it; ``landmarks``,
-    ``hop_cost``, ``window_length`` and ``window_step`` None for "auto", ``window_length``
-    inf for "none", the whole log): the store's flattened grid columns."""
+    ``hop_cost``, ``diffusion_time``, ``window_length`` and ``window_step`` None for "auto",
+    ``diffusion_time`` and ``window_length`` inf for "none", the paper's weights and whole
+    log): the store's flattened grid columns."""
     flat = {}
     for p in PARAMS:
         value = config.get(p.table, {}).get(p.name)
-        flat[p.name] = (float("inf") if (p.name, value) == ("window_length", "none")
+        flat[p.name] = (float("inf") if value == "none" and p.name in ("diffusion_time", "window_length")
                         else None if value in ("auto", "none") else value)
     return flat
 
@@ -465,7 +469,8 @@ def _canonical(point: dict, inputs: _InputFiles, fail):
                  f"after the end of the run (duration = {swarm['duration']:g} s)")
 
     mapping = {name: point[("map", name)]
-               for name in ("metric", "hop_cost", "window_length", "subsample", "landmarks", "maxdim", "classifier")}
+               for name in ("metric", "hop_cost", "diffusion_time", "window_length", "subsample", "landmarks",
+                            "maxdim", "classifier")}
     if mapping["window_length"] != "none":
         mapping["window_step"] = point[("map", "window_step")]
     if mapping["window_length"] == "auto":

@@ -37,7 +37,7 @@ from ..errors import SwarmtopoError
 from ..io import GROUND_TRUTH_META_KEYS, read_arena, read_log, write_log
 from ..log import EncounterLog
 from ..persistence import snr
-from ..pipeline import MapConfig, map_encounters, software_versions, window_length_option
+from ..pipeline import MapConfig, map_encounters, software_versions, seconds_option
 from ..sim import simulate
 from .grid import Job, flat_columns
 from .store import JOB_COLUMNS, ResultStore
@@ -127,7 +127,8 @@ def run_job(job: Job) -> dict[str, Any]:
         map_config = MapConfig(
             metric=mapping["metric"], subsample=mapping["subsample"],
             hop_cost=None if mapping["hop_cost"] == "auto" else mapping["hop_cost"],
-            window_length=window_length_option(mapping["window_length"]),
+            diffusion_time=seconds_option(mapping["diffusion_time"]),
+            window_length=seconds_option(mapping["window_length"]),
             window_encounters=mapping.get("window_encounters", MapConfig.window_encounters),
             window_step=None if mapping.get("window_step", "auto") == "auto" else mapping["window_step"],
             landmarks=None if mapping["landmarks"] == "auto" else mapping["landmarks"],
