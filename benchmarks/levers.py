@@ -32,6 +32,8 @@ diffusion time):
 * ``mds-D`` -- Vietoris-Rips on the landmarks' classical MDS coordinates in R^D (the
   projection on the top D eigenvectors as a denoiser) instead of their metric.
 * ``FIELD=VALUE`` -- ``MapConfig(FIELD=VALUE)`` (e.g. ``subsample=knn``, ``metric=plain``).
+* ``mix`` -- the windows of K = 15 and 25 encounters per agent and the whole log, all
+  in one vote; ``mix-20-25-30`` those of K = 20, 25 and 30.
 * ``witness`` -- lazy witness complex (nu = 1) on the landmarks with every event of the
   window as a witness, instead of Vietoris-Rips: edge (i, j) enters at
   min_w max(d(w, l_i), d(w, l_j)) - m_w, m_w the distance of w to its nearest landmark.
@@ -85,6 +87,15 @@ def _draws(log, seed, k=3):
         more, _ = _windows_of(log, seed + d)
         regions = [a + b for a, b in zip(regions, more)]
     return regions, beta0
+
+
+def _window_mix(log, seed, encounters=(15.0, 25.0), whole=True):
+    """The windows of several K (encounters per agent), and the whole log, in one vote."""
+    runs = [_windows_of(log, seed, window_encounters=k) for k in encounters]
+    if whole:
+        runs.append(_windows_of(log, seed, window_length=WHOLE_LOG))
+    regions = [sum((list(r[i]) for r, _ in runs), []) for i in range(len(runs[0][0]))]
+    return regions, runs[0][1]
 
 
 def _switch_graph(log, metric="plain", *, window=None, hop_cost=0.0, diffusion_time=np.inf):
@@ -215,6 +226,8 @@ VARIANTS = {
     "hop-half": _hop_times(0.5),
     "hop-double": _hop_times(2.0),
     "dense": _dense,
+    "mix": _window_mix,
+    "mix-20-25-30": lambda log, seed: _window_mix(log, seed, (20.0, 25.0, 30.0), whole=False),
 }
 
 
