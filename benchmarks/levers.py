@@ -32,6 +32,8 @@ diffusion time):
 * ``mds-D`` -- Vietoris-Rips on the landmarks' classical MDS coordinates in R^D (the
   projection on the top D eigenvectors as a denoiser) instead of their metric.
 * ``FIELD=VALUE`` -- ``MapConfig(FIELD=VALUE)`` (e.g. ``subsample=knn``, ``metric=plain``).
+* ``log-C`` -- chain gaps compressed logarithmically instead, tau ln(1 + w / tau), with
+  tau = C x the mean time between an agent's encounters.
 * ``mix`` -- the windows of K = 15 and 25 encounters per agent and the whole log, all
   in one vote; ``mix-20-25-30`` those of K = 20, 25 and 30.
 * ``witness`` -- lazy witness complex (nu = 1) on the landmarks with every event of the
@@ -87,6 +89,17 @@ def _draws(log, seed, k=3):
         more, _ = _windows_of(log, seed + d)
         regions = [a + b for a, b in zip(regions, more)]
     return regions, beta0
+
+
+def _log_gaps(log, seed, factor):
+    """Chain gaps compressed logarithmically, tau ln(1 + w / tau), tau = factor x the mean gap."""
+    original = G.diffusive_weight
+    tau = factor * mean_agent_gap(log)
+    G.diffusive_weight = lambda weight, diffusion_time: tau * np.log1p(weight / tau)
+    try:
+        return _windows_of(log, seed)
+    finally:
+        G.diffusive_weight = original
 
 
 def _window_mix(log, seed, encounters=(15.0, 25.0), whole=True):
@@ -194,6 +207,8 @@ def _variant(name):
         return _override(name)
     if name.startswith("mds-"):
         return lambda log, seed: _mds(log, seed, int(name.split("-", 1)[1]))
+    if name.startswith("log-"):
+        return lambda log, seed: _log_gaps(log, seed, float(name.split("-", 1)[1]))
     if name.startswith(("diffusive-", "switch-")):
         mapper = _windows_of if name.startswith("diffusive-") else _switch
         factor = float(name.split("-", 1)[1])
@@ -253,7 +268,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--per-cell", type=int, default=12)
     parser.add_argument("--variants", nargs="+", default=["default", "20s", "whole", "quarter", "draws", "switch"],
-                        help=f"{', '.join(sorted(VARIANTS))}, diffusive-C, switch-C, mds-D or FIELD=VALUE")
+                        help=f"{', '.join(sorted(VARIANTS))}, diffusive-C, switch-C, log-C, mds-D or FIELD=VALUE")
     parser.add_argument("--cells", nargs="+", metavar="TEXT",
                         help="only the cells whose name contains one of these (default: all)")
     parser.add_argument("--processes", type=int, default=2)
