@@ -30,10 +30,10 @@ import numpy as np
 from swarmtopo import __version__
 from swarmtopo.experiments.accuracy import CELLS, HELD_OUT_FAMILY, SUITE, TUNING_PER_CELL, cell_of, tuning_jobs, tuning_session
 from swarmtopo.experiments.store import read_jobs
-from swarmtopo.experiments.sweep import run_sweep
+from swarmtopo.experiments.sweep import job_map_config, run_sweep
 from swarmtopo.experiments.tuning import (GAMMA_GRID, Q_GRID, TAU_GRID, calibrated_classifier, exact,
                                          fit_thresholds, maps_from_rows)
-from swarmtopo.pipeline import MapConfig, seconds_option
+from swarmtopo.pipeline import MapConfig
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -54,6 +54,10 @@ chosen on tuning cases with ``benchmarks/levers.py``).  Windows of K encounters 
 agent are K times the mean time between an agent's encounters long
 (``MapConfig.window_encounters``).  Candidates measured in earlier rounds (fixed 20 s
 windows, the whole log with h, h = 0 with windows) are in docs/tuning.md's history."""
+
+
+CHOSEN_FIELDS = ("metric", "hop_cost", "diffusion_time", "window_length", "window_encounters", "window_step")
+"""The MapConfig fields the candidates set: the winner's must be MapConfig's defaults."""
 
 
 def main() -> None:
@@ -92,12 +96,7 @@ def main() -> None:
                   f"paper form {sum(paper_form)}/{len(candidate_rows)}")
     best = max(results, key=lambda n: (results[n]["right"], min(r[0] for r in results[n]["per_cell"].values())))
     winner = CANDIDATES[best]
-    defaults = MapConfig()
-    expected = {"hop_cost": None if winner["hop_cost"] == "auto" else winner["hop_cost"],
-                "diffusion_time": seconds_option(winner["diffusion_time"]),
-                "window_length": seconds_option(winner["window_length"]),
-                "window_encounters": winner.get("window_encounters", defaults.window_encounters),
-                "window_step": None if winner.get("window_step", "auto") == "auto" else winner["window_step"]}
+    defaults, chosen_config = MapConfig(), job_map_config(jobs[best][0].config["map"])
     chosen = results[best]
     model = calibrated_classifier(chosen["maps"], chosen["fit"], provenance={
         "name": "default", "script": "scripts/tune_accuracy.py", "suite": SUITE, "pipeline": winner,
@@ -107,7 +106,8 @@ def main() -> None:
     job_minutes = sum(r["t_total"] for candidate_rows in rows.values() for r in candidate_rows) / 60
     _write_doc(results, best, args, time.perf_counter() - started, summary, job_minutes)
     print(f"winner: {best}; wrote classifier-default.json and docs/tuning.md")
-    mismatch = {k: (getattr(defaults, k), v) for k, v in expected.items() if getattr(defaults, k) != v}
+    mismatch = {k: (getattr(defaults, k), getattr(chosen_config, k)) for k in CHOSEN_FIELDS
+                if getattr(defaults, k) != getattr(chosen_config, k)}
     if mismatch:
         raise SystemExit(f"MapConfig defaults differ from the winner: {mismatch}; update swarmtopo/pipeline.py")
 

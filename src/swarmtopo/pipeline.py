@@ -60,9 +60,9 @@ WHOLE_LOG = float("inf")
 
 
 def seconds_option(value: str | float | None) -> float | None:
-    """``MapConfig.window_length`` or ``diffusion_time`` of a command-line or sweep value:
-    "auto" (or None) -> None (from the data), "none" -> inf (``WHOLE_LOG``; no diffusive
-    weights), a number -> that many seconds."""
+    """A ``MapConfig`` time in seconds (``hop_cost``, ``diffusion_time``, ``window_length``,
+    ``window_step``) from a command-line or sweep value: "auto" (or None) -> None (from the
+    data), "none" -> inf (``WHOLE_LOG``; no diffusive weights), a number -> that many seconds."""
     if value is None or value == "auto":
         return None
     return WHOLE_LOG if value == "none" else float(value)

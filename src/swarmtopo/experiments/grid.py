@@ -382,14 +382,14 @@ def expand_grid(document: dict, *, source: str = "<grid>", base_dir=None,
 
 
 def flat_columns(config: dict) -> dict[str, Any]:
-    """One value per ``PARAMS`` key (None where the config does not use it; ``landmarks``,
-    ``hop_cost``, ``diffusion_time``, ``window_length`` and ``window_step`` None for "auto",
-    ``diffusion_time`` and ``window_length`` inf for "none", the paper's weights and whole
-    log): the store's flattened grid columns."""
+    """One value per ``PARAMS`` key: None where the config does not use it and for "auto"
+    (from the data), inf for "none" in a number column (``diffusion_time`` and
+    ``window_length``: the paper's weights, the whole log): the store's flattened grid
+    columns."""
     flat = {}
     for p in PARAMS:
         value = config.get(p.table, {}).get(p.name)
-        flat[p.name] = (float("inf") if value == "none" and p.name in ("diffusion_time", "window_length")
+        flat[p.name] = (float("inf") if value == "none" and p.sql == "DOUBLE"
                         else None if value in ("auto", "none") else value)
     return flat
 

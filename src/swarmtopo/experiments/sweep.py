@@ -94,6 +94,21 @@ def stripped_log(log: EncounterLog) -> EncounterLog:
         return read_log(folder)
 
 
+def job_map_config(mapping: dict[str, Any], seed: int | None = None) -> MapConfig:
+    """The ``MapConfig`` of a job's canonical ``[map]`` table ("auto" -> None, from the
+    data; "none" -> inf), as sweeps map: no picture, no loops."""
+    return MapConfig(
+        metric=mapping["metric"], subsample=mapping["subsample"],
+        hop_cost=seconds_option(mapping["hop_cost"]),
+        diffusion_time=seconds_option(mapping["diffusion_time"]),
+        window_length=seconds_option(mapping["window_length"]),
+        window_encounters=mapping.get("window_encounters", MapConfig.window_encounters),
+        window_step=seconds_option(mapping.get("window_step")),
+        landmarks=None if mapping["landmarks"] == "auto" else mapping["landmarks"],
+        max_landmarks=mapping.get("max_landmarks", MapConfig.max_landmarks),
+        maxdim=mapping["maxdim"], seed=seed, embed_dim=0, cycles=False)
+
+
 def run_job(job: Job) -> dict[str, Any]:
     """Simulate and map one job; its row of the store's ``jobs`` table.
 
@@ -124,17 +139,7 @@ def run_job(job: Job) -> dict[str, Any]:
         row["t_simulate"] = time.perf_counter() - t0
         row["n_events"], row["n_agents"] = sim.log.n_events, sim.log.n_agents
         classifier = _classifier(mapping["classifier"], job.file("map.classifier"))
-        map_config = MapConfig(
-            metric=mapping["metric"], subsample=mapping["subsample"],
-            hop_cost=None if mapping["hop_cost"] == "auto" else mapping["hop_cost"],
-            diffusion_time=seconds_option(mapping["diffusion_time"]),
-            window_length=seconds_option(mapping["window_length"]),
-            window_encounters=mapping.get("window_encounters", MapConfig.window_encounters),
-            window_step=None if mapping.get("window_step", "auto") == "auto" else mapping["window_step"],
-            landmarks=None if mapping["landmarks"] == "auto" else mapping["landmarks"],
-            max_landmarks=mapping.get("max_landmarks", MapConfig.max_landmarks),
-            maxdim=mapping["maxdim"], seed=seeds["map"], embed_dim=0, cycles=False)
-        tmap = map_encounters(stripped_log(sim.log), map_config, classifier=classifier)
+        tmap = map_encounters(stripped_log(sim.log), job_map_config(mapping, seeds["map"]), classifier=classifier)
     except SwarmtopoError as exc:
         row["error"] = " ".join(str(exc).split())
     else:
