@@ -5,11 +5,11 @@ Each variant maps the tuning cases of ``swarmtopo-accuracy/1`` (inside
 ground truth, and the ratio classifier (q_1, tau_1, gamma_1) is fitted for each variant
 on its own maps (``experiments.tuning.fit_thresholds``), so a variant is compared at
 its best.  Printed per variant: fitted exact (beta_0, beta_1), the 4-fold
-cross-validated count (thresholds fitted without each quarter), per-cell counts and
-seconds per map.
+cross-validated count (thresholds fitted without each quarter), per-cell counts, counts
+per hole family (the family of a case's holes; "no hole" for none) and seconds per map.
 
 Variants (all: hybrid metric, maxmin, automatic landmarks, h = r_d / v_c, automatic
-diffusion time):
+diffusion time, wall following x 2):
 
 * ``default`` -- ``MapConfig()``.
 * ``20s`` -- fixed 20 s windows overlapping by half (the previous default).
@@ -18,7 +18,8 @@ diffusion time):
 * ``draws`` -- three landmark draws (seeds) per window, all their counts voted.
 * ``switch`` -- a cost per change of agent instead of per hop: every pair of one
   agent's events joined with D_tau(its chain time) + h (the paper's all-pairs graph plus
-  h: a path pays h once per agent it rides), built literally, O(m^2) per agent.
+  h: a path pays h once per agent it rides), built literally, O(m^2) per agent; wall
+  following is charged like any other time.
 * ``geodesic`` -- Vietoris-Rips on geodesic distances of a k-NN graph of the landmarks
   (k = 10, joined with a minimum spanning tree so it is connected): the Isomap-style
   re-estimate of the landmark metric from its shortest distances only.
@@ -29,6 +30,13 @@ diffusion time):
   encounters (the default is C = ``DIFFUSION_GAP_FACTOR``; ``diffusion_time=inf`` is
   off, the paper's weights); ``switch-C`` the same with ``switch``, where D_tau applies
   to a whole ride on one agent, not to each gap.
+* ``wall-C`` -- an agent's wall-following time weighs C per second outside the
+  diffusive weights (``MapConfig.wall_follow_weight``; the default is C = 2);
+  ``wall-none`` charges it like any other time.
+* ``smooth-HOW-K`` -- Vietoris-Rips on neighbourhood-averaged landmark distances:
+  d~(l_i, l_j) = (A_ij + A_ji) / 2 with A_ij the mean (HOW = ``mean``) or median
+  (``median``) of d(l_i, y) over the K nodes y nearest l_j, or that mean minus their
+  mean distance to l_j (``meanc``): a denoiser of each landmark's own distortion.
 * ``mds-D`` -- Vietoris-Rips on the landmarks' classical MDS coordinates in R^D (the
   projection on the top D eigenvectors as a denoiser) instead of their metric.
 * ``FIELD=VALUE`` -- ``MapConfig(FIELD=VALUE)`` (e.g. ``subsample=knn``, ``metric=plain``).
@@ -111,9 +119,11 @@ def _window_mix(log, seed, encounters=(15.0, 25.0), whole=True):
     return regions, runs[0][1]
 
 
-def _switch_graph(log, metric="plain", *, window=None, hop_cost=0.0, diffusion_time=np.inf):
+def _switch_graph(log, metric="plain", *, window=None, hop_cost=0.0, diffusion_time=np.inf, wall_follow_weight=None):
     """The per-change-of-agent metric: every pair of one agent's events joined with
-    D_tau(the chain time between them) (stops contracted as in the paper) + h."""
+    D_tau(the chain time between them) (stops contracted as in the paper) + h; wall
+    following is charged like any other time (``_switch`` maps with it off)."""
+    assert wall_follow_weight is None, "the per-ride metric does not split off wall following"
     chains = G.chain_edges(log, metric, window)
     heads = np.flatnonzero(np.r_[True, chains.agent[1:] != chains.agent[:-1], True])
     u, v, w = [], [], []
@@ -130,7 +140,7 @@ def _switch(log, seed, **options):
     original = P.build_graph
     P.build_graph = _switch_graph
     try:
-        return _windows_of(log, seed, **options)
+        return _windows_of(log, seed, wall_follow_weight=None, **options)
     finally:
         P.build_graph = original
 
@@ -194,6 +204,23 @@ def _mds(log, seed, dim):
     return _other_filtration(log, seed, lambda window, sub: _planar_distances(window.landmarks.distances, dim))
 
 
+def _smoothed_distances(to_nodes: np.ndarray, k: int, how: str) -> np.ndarray:
+    """d~ of ``smooth-HOW-K`` from the (L, N) landmark-to-node distances (row i: l_i)."""
+    near = np.argsort(to_nodes, axis=1, kind="stable")[:, :k]  # the K nodes nearest each landmark
+    around = to_nodes[:, near]  # (L, L, K): d(l_i, y) for y near l_j
+    averaged = np.median(around, axis=-1) if how == "median" else around.mean(axis=-1)
+    if how == "meanc":
+        averaged = averaged - np.take_along_axis(to_nodes, near, axis=1).mean(axis=1)[None, :]
+    values = np.maximum(0.5 * (averaged + averaged.T), 0.0)
+    np.fill_diagonal(values, 0.0)
+    return values
+
+
+def _smooth(log, seed, how, k):
+    return _other_filtration(log, seed, lambda window, sub: _smoothed_distances(
+        sub.distances_from(window.landmarks.nodes), k, how))
+
+
 def _override(text):
     """The variant ``FIELD=VALUE``: MapConfig(FIELD=VALUE), VALUE read as the field's default's type."""
     field, value = text.split("=", 1)
@@ -205,6 +232,12 @@ def _override(text):
 def _variant(name):
     if "=" in name:
         return _override(name)
+    if name.startswith("wall-"):
+        value = name.split("-", 1)[1]
+        return lambda log, seed: _windows_of(log, seed, wall_follow_weight=None if value == "none" else float(value))
+    if name.startswith("smooth-"):
+        _, how, k = name.split("-")
+        return lambda log, seed: _smooth(log, seed, how, int(k))
     if name.startswith("mds-"):
         return lambda log, seed: _mds(log, seed, int(name.split("-", 1)[1]))
     if name.startswith("log-"):
@@ -254,13 +287,14 @@ def _run(task):
     streams = case_streams(seed)
     arena = build_arena(arena_table, streams["arena"])
     log = stripped_log(simulate(arena, cell.agents, cell.duration, rng=streams["simulation"]).log)
+    family = arena_table["shapes"][0] if arena_table["holes"] else "no hole"
     start = time.perf_counter()
     try:
         regions, beta0 = _variant(name)(log, seed % 2**32)
     except SwarmtopoError:
-        return None, cell.name, time.perf_counter() - start
+        return None, cell.name, family, time.perf_counter() - start
     truth = arena.betti
-    return (TuningMap(tuple(tuple(r) for r in regions), beta0, truth[0], truth[1], cell.name), cell.name,
+    return (TuningMap(tuple(tuple(r) for r in regions), beta0, truth[0], truth[1], cell.name), cell.name, family,
             time.perf_counter() - start)
 
 
@@ -268,7 +302,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--per-cell", type=int, default=12)
     parser.add_argument("--variants", nargs="+", default=["default", "20s", "whole", "quarter", "draws", "switch"],
-                        help=f"{', '.join(sorted(VARIANTS))}, diffusive-C, switch-C, log-C, mds-D or FIELD=VALUE")
+                        help=f"{', '.join(sorted(VARIANTS))}, diffusive-C, switch-C, log-C, wall-C, wall-none, "
+                             "smooth-HOW-K, mds-D or FIELD=VALUE")
     parser.add_argument("--cells", nargs="+", metavar="TEXT",
                         help="only the cells whose name contains one of these (default: all)")
     parser.add_argument("--processes", type=int, default=2)
@@ -282,7 +317,7 @@ def main() -> None:
         tasks = [(name, c, i) for i in range(args.per_cell) for c in cells]
         with ProcessPoolExecutor(args.processes) as pool:
             results = list(pool.map(_run, tasks))
-        maps = [m for m, _, _ in results if m is not None]
+        maps = [m for m, _, _, _ in results if m is not None]
         fit = fit_thresholds(maps)
         right = exact(maps, fit.thresholds)
         fold = np.arange(len(maps)) % 4
@@ -290,10 +325,14 @@ def main() -> None:
                            fit_thresholds([m for m, f in zip(maps, fold) if f != k]).thresholds).sum())
                  for k in range(4))
         per_cell = [int(sum(ok for m, ok in zip(maps, right) if m.cell == CELLS[c].name)) for c in cells]
-        seconds = np.mean([s for _, _, s in results])
+        family_of = [f for m, _, f, _ in results if m is not None]
+        per_family = ", ".join(f"{f} {sum(ok for g, ok in zip(family_of, right) if g == f)}/{family_of.count(f)}"
+                               for f in sorted(set(family_of)))
+        seconds = np.mean([s for _, _, _, s in results])
         th = fit.thresholds
         print(f"{name}: {int(right.sum())}/{len(tasks)} exact (q {th.q:g}, tau {th.tau:g}, gamma {th.gamma:g}); "
-              f"4-fold CV {cv}/{len(tasks)}; per cell {per_cell}; {seconds:.2f} s per map", flush=True)
+              f"4-fold CV {cv}/{len(tasks)}; per cell {per_cell}; per hole family {per_family}; "
+              f"{seconds:.2f} s per map", flush=True)
 
 
 if __name__ == "__main__":

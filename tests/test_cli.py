@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from swarmtopo.io import read_log, strip_ground_truth
+from swarmtopo.pipeline import MapConfig
 
 
 def run(*args, cwd=None):
@@ -186,12 +187,13 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     doc = json.loads((tmp_path / "p" / "map.json").read_text())
     assert doc["params"]["hop_cost"] == 0.0 and doc["params"]["window_length"] == "inf"
     assert doc["params"]["diffusion_time"] == "inf" and doc["params"]["diffusion_time_used"] is None
-    assert doc["params"]["window_length_used"] is None
+    assert doc["params"]["window_length_used"] is None and doc["params"]["wall_follow_weight"] is None
     assert doc["classifier"]["classifier"] == "paper" and len(doc["regions"][0]["windows"]) == 1
     default = run("map", simulated[0], "--out", tmp_path / "d", "--hop-cost", "1.5", "--window-length", "8",
-                  "--diffusion-time", "0.4")
+                  "--diffusion-time", "0.4", "--wall-follow-weight", "1.5")
     assert default.returncode == 0, default.stderr
     doc = json.loads((tmp_path / "d" / "map.json").read_text())
+    assert doc["params"]["wall_follow_weight"] == 1.5
     assert doc["params"]["hop_cost_used"] == 1.5 and doc["params"]["window_length"] == 8.0
     assert doc["params"]["diffusion_time_used"] == 0.4 and doc["params"]["diffusion_time_source"] == "given"
     assert len(doc["regions"][0]["windows"]) > 1
@@ -199,11 +201,15 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     assert auto.returncode == 0, auto.stderr
     doc = json.loads((tmp_path / "a" / "map.json").read_text())
     assert doc["params"]["window_length"] is None and "encounters" in doc["params"]["window_source"]
+    assert doc["params"]["wall_follow_weight"] == MapConfig.wall_follow_weight
     assert_one_line_error(run("map", simulated[0], "--paper", "--hop-cost", "1"), "--paper fixes --hop-cost", code=2)
     assert_one_line_error(run("map", simulated[0], "--paper", "--diffusion-time", "1"),
                           "--paper fixes --diffusion-time", code=2)
     assert_one_line_error(run("map", simulated[0], "--window-length", "-3"), "positive number", code=2)
     assert_one_line_error(run("map", simulated[0], "--diffusion-time", "0"), "positive number", code=2)
+    assert_one_line_error(run("map", simulated[0], "--paper", "--wall-follow-weight", "1"),
+                          "--paper fixes --wall-follow-weight", code=2)
+    assert_one_line_error(run("map", simulated[0], "--wall-follow-weight", "-1"), "number >= 0", code=2)
     assert_one_line_error(run("map", simulated[0], "--hop-cost", "-1"), "--hop-cost", code=2)
 
 

@@ -10,8 +10,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from swarmtopo.errors import InputError
-from swarmtopo.graph import METRICS, EncounterGraph, build_graph, literal_distances
-from swarmtopo.log import RW, S, STATES, EncounterLog
+from swarmtopo.graph import METRICS, EncounterGraph, build_graph, literal_distances, state_time
+from swarmtopo.log import RW, S, STATES, WF, EncounterLog
 
 INF = np.inf
 
@@ -177,27 +177,28 @@ def merged(intervals):
     return out
 
 
-def stops_from_status_rows(log: EncounterLog) -> dict[int, list[tuple[float, float]]]:
-    """Stop intervals read literally off the status rows, without log.stop_intervals():
-    per agent in time order, a row saying S starts (or continues) a stop that lasts
-    until the agent's next row, or forever if it has none."""
+def intervals_in_state(log: EncounterLog, state_name: str) -> dict[int, list[tuple[float, float]]]:
+    """Per agent, the intervals [row, next row of the agent) whose status row says
+    ``state_name``, read literally off the status rows without log.stop_intervals():
+    in time order, a row starts (or continues) the state until the agent's next row,
+    or forever if it has none."""
     rows = {}
     for t, agent, state in zip(log.status_t.tolist(), log.status_agent.tolist(), log.status_state.tolist()):
         rows.setdefault(agent, []).append((t, STATES[state]))
-    stops = {}
+    out = {}
     for agent, seq in rows.items():
         seq.sort()
         for (t, state), (t_next, _) in zip(seq, seq[1:] + [(INF, None)]):
-            if state == "S":
-                stops.setdefault(agent, []).append((t, t_next))
-    return stops
+            if state == state_name:
+                out.setdefault(agent, []).append((t, t_next))
+    return out
 
 
 def networkx_distances(log: EncounterLog, metric: str, window=None) -> np.ndarray:
     """The paper's definition literally: every pair of events sharing an agent."""
     lo, hi = (-INF, INF) if window is None else window
     events = [(float(t), {int(a), int(b)}) for t, a, b in zip(log.t, log.a, log.b) if lo <= t <= hi]
-    stops = stops_from_status_rows(log) if metric != "plain" else {}
+    stops = intervals_in_state(log, "S") if metric != "plain" else {}
     if metric == "hybrid":
         for agent, time in zip(log.static_agent, log.static_time):
             stops.setdefault(int(agent), []).append((float(time), INF))
@@ -407,12 +408,15 @@ def test_hop_cost_hand_computed_on_the_chain_graph():
     np.testing.assert_array_equal(event_distances(graph), expected)
 
 
-def chain_distances_with_hop_cost(log: EncounterLog, metric: str, h: float, tau: float = INF) -> np.ndarray:
+def chain_distances_with_hop_cost(log: EncounterLog, metric: str, h: float, tau: float = INF,
+                                  c: float | None = None) -> np.ndarray:
     """Literal chain metric with per-hop cost: each agent's events in time order, joined
     consecutively by the paper's weight w (0 inside one stop interval of that agent, read
-    off the status rows as in networkx_distances), made diffusive, tau (sqrt(1 + 2 w / tau)
-    - 1), unless tau is inf, plus h."""
-    stops = stops_from_status_rows(log) if metric != "plain" else {}
+    off the status rows as in networkx_distances); with c, the gap's overlap f with the
+    agent's wall-following intervals is split off and weighs c f; the rest is made
+    diffusive, tau (sqrt(1 + 2 w / tau) - 1), unless tau is inf; plus h."""
+    following = intervals_in_state(log, "WF")
+    stops = intervals_in_state(log, "S") if metric != "plain" else {}
     if metric == "hybrid":
         for agent, time in zip(log.static_agent, log.static_time):
             stops.setdefault(int(agent), []).append((float(time), INF))
@@ -425,7 +429,9 @@ def chain_distances_with_hop_cost(log: EncounterLog, metric: str, h: float, tau:
             ti, tj = float(log.t[i]), float(log.t[j])
             still = any(s <= ti <= e and s <= tj <= e for s, e in stops.get(k, []))
             w = 0.0 if still else tj - ti
-            w = (w if tau == INF else tau * (math.sqrt(1 + 2 * w / tau) - 1)) + h
+            f = 0.0 if c is None or still else sum(max(0.0, min(tj, e) - max(ti, s))
+                                                   for s, e in following.get(k, []))
+            w = (w - f if tau == INF else tau * (math.sqrt(1 + 2 * (w - f) / tau) - 1)) + (c or 0.0) * f + h
             if not g.has_edge(i, j) or g[i][j]["weight"] > w:
                 g.add_edge(i, j, weight=w)
     out = np.full((log.n_events, log.n_events), INF)
@@ -437,13 +443,14 @@ def chain_distances_with_hop_cost(log: EncounterLog, metric: str, h: float, tau:
 
 @settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(log=small_logs(), h=st.sampled_from([0.5, 2.0]), tau=st.sampled_from([INF, 0.7, 3.0]),
-       metric=st.sampled_from(METRICS))
-def test_hop_cost_graph_equals_literal_chain(log, h, tau, metric):
-    graph = build_graph(log, metric, hop_cost=h, diffusion_time=tau)
+       c=st.sampled_from([None, 0.0, 2.0]), metric=st.sampled_from(METRICS))
+def test_hop_cost_graph_equals_literal_chain(log, h, tau, c, metric):
+    graph = build_graph(log, metric, hop_cost=h, diffusion_time=tau, wall_follow_weight=c)
     distances = event_distances(graph)
-    np.testing.assert_allclose(distances, chain_distances_with_hop_cost(log, metric, h, tau), rtol=0, atol=1e-9)
-    # D_tau(w) <= w: diffusive weights never lengthen a path
-    assert (distances <= event_distances(build_graph(log, metric, hop_cost=h)) + 1e-9).all()
+    np.testing.assert_allclose(distances, chain_distances_with_hop_cost(log, metric, h, tau, c), rtol=0, atol=1e-9)
+    # D_tau(w - f) + c f <= w for c <= 1: diffusive weights never lengthen a path
+    if c is None or c <= 1:
+        assert (distances <= event_distances(build_graph(log, metric, hop_cost=h)) + 1e-9).all()
 
 
 def test_diffusive_weights_hand_computed():
@@ -460,6 +467,46 @@ def test_diffusive_weights_hand_computed():
     assert distances[1, 3] == pytest.approx(d(3) + d(2))
     assert distances[0, 4] == pytest.approx(d(1) + 4.0)
     assert event_distances(build_graph(stop_and_static_log(), "plain"))[0, 3] == 6.0
+
+
+def wall_following_log() -> EncounterLog:
+    """Agent 0 meets agent 1 at t = 1 and agent 2 at t = 7; its status: RW at 0, WF at
+    2, RW at 5, S at 8 (agent 1 has no status rows, agent 2 is WF from t = 6 on)."""
+    return EncounterLog.from_records([1, 7], [0, 0], [1, 2],
+                                     status=([0, 2, 5, 8, 6], [0, 0, 0, 0, 2], ["RW", "WF", "RW", "S", "WF"]))
+
+
+def test_state_time_hand_computed():
+    log = wall_following_log()
+    agent = np.array([0, 0, 0, 0, 0, 1, 2, 2])
+    t0 = np.array([1.0, 3.0, 0.0, 5.0, 9.0, 0.0, 0.0, 6.5])
+    t1 = np.array([6.0, 4.0, 10.0, 8.0, 12.0, 10.0, 10.0, 6.5])
+    # agent 0 is WF in [2, 5): 3, 1, 3, 0, 0 s; agent 1 has no rows: 0; agent 2 from 6 on: 4, 0
+    np.testing.assert_allclose(state_time(log, WF, agent, t0, t1), [3, 1, 3, 0, 0, 0, 4, 0])
+    # stops: agent 0 is S from 8 on (the last row lasts forever)
+    np.testing.assert_allclose(state_time(log, S, agent[:5], t0[:5], t1[:5]), [0, 0, 2, 0, 3])
+
+
+def test_wall_following_weight_hand_computed():
+    # Agent 0's gap e0 (t=1) -> e1 (t=7) is 6 s, of which 3 s wall following (in [2, 5)).
+    # tau = 4, c = 2: D_4(6 - 3) + 2 x 3 = 4 (sqrt(1 + 6 / 4) - 1) + 6 = 8.325, plus h = 0.5.
+    log = wall_following_log()
+    d = event_distances(build_graph(log, "plain", hop_cost=0.5, diffusion_time=4.0, wall_follow_weight=2.0))
+    assert d[0, 1] == pytest.approx(4.0 * (math.sqrt(2.5) - 1.0) + 6.0 + 0.5)
+    # None: the whole 6 s is diffusive, D_4(6) = 4; with tau = inf and c = 1 it is the paper's 6 s
+    none = event_distances(build_graph(log, "plain", diffusion_time=4.0))
+    assert none[0, 1] == pytest.approx(4.0)
+    assert event_distances(build_graph(log, "plain", wall_follow_weight=1.0))[0, 1] == pytest.approx(6.0)
+    # a log without status rows is unaffected
+    bare = EncounterLog.from_records([1, 7], [0, 0], [1, 2])
+    assert event_distances(build_graph(bare, "plain", diffusion_time=4.0, wall_follow_weight=2.0))[0, 1] == \
+        pytest.approx(4.0)
+
+
+@pytest.mark.parametrize("bad", [-1.0, float("nan"), float("inf"), "two"])
+def test_bad_wall_following_weight_is_an_input_error(bad):
+    with pytest.raises(InputError, match="wall-following weight"):
+        build_graph(wall_following_log(), "plain", wall_follow_weight=bad)
 
 
 @pytest.mark.parametrize("bad", [0.0, -1.0, float("nan"), "two"])

@@ -131,7 +131,8 @@ def test_encmds_table_matches_the_pipeline_on_its_seeds(encmds_two_runs):
     assert [int(r["seed"]) for r in rows] == [rp.run_seed("encmds", i) for i in range(2)]
     for row in rows:
         sim = simulate(default_arena(), rp.AGENTS, rp.DURATION, rng=int(row["seed"]))
-        paper = MapConfig(metric="plain", hop_cost=0.0, diffusion_time=WHOLE_LOG, window_length=WHOLE_LOG, embed_dim=0)
+        paper = MapConfig(metric="plain", hop_cost=0.0, diffusion_time=WHOLE_LOG, wall_follow_weight=None,
+                          window_length=WHOLE_LOG, embed_dim=0)
         tmap = map_encounters(sim.log, paper, classifier=load_classifier(rp.PAPER_CLASSIFIER))
         assert int(row["beta_1"]) == tmap.betti[1]
         assert number(row["longest_h1"]) == tmap.diagram.lengths(1)[0]
@@ -191,7 +192,8 @@ def test_encimpr_compares_the_three_metrics_on_the_right_logs(tmp_path, monkeypa
     short = next(r for r in rows if r["metric"] == "plain" and float(r["duration"]) == 20.0)
     sim = simulate(default_arena(), rp.AGENTS, 30.0, rng=int(short["seed"]))
     tmap = map_encounters(sim.log, MapConfig(metric="plain", hop_cost=0.0, diffusion_time=WHOLE_LOG,
-                                             window_length=WHOLE_LOG, embed_dim=0, window=(None, 20.0)))
+                                             wall_follow_weight=None, window_length=WHOLE_LOG, embed_dim=0,
+                                             window=(None, 20.0)))
     assert int(short["events"]) == tmap.n_events == np.count_nonzero(sim.log.t <= 20.0)
     assert number(short["longest_h1"]) == tmap.diagram.lengths(1)[0]
     for key, agg in result.summary["conditions"].items():

@@ -23,7 +23,7 @@ import pytest
 from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.experiments.grid import expand_grid, read_sweep
 from swarmtopo.experiments.store import RUN_COLUMNS, ResultStore, read_jobs
-from swarmtopo.experiments.sweep import run_job, run_sweep
+from swarmtopo.experiments.sweep import job_map_config, run_job, run_sweep
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "sweep-small.toml"
 
@@ -86,13 +86,25 @@ def test_grid_is_the_product_of_lists_times_replicates_with_defaults():
         "arena": {"generator": "random", "holes": job.config["arena"]["holes"], "shapes": ["square"],
                   "outer": "square", "scale": 1.0},
         "swarm": {"agents": job.config["swarm"]["agents"], "duration": 20.0, "static_fraction": 0.0},
-        "map": {"metric": "hybrid", "hop_cost": "auto", "diffusion_time": "auto", "window_length": "auto",
-                "window_encounters": 25.0,
+        "map": {"metric": "hybrid", "hop_cost": "auto", "diffusion_time": "auto", "wall_follow_weight": 2.0,
+                "window_length": "auto", "window_encounters": 20.0,
                 "window_step": "auto", "subsample": "maxmin", "landmarks": "auto", "max_landmarks": 400, "maxdim": 1, "classifier": "default"},
     }
     # max_landmarks only caps "auto": a fixed L drops it
     assert "max_landmarks" not in next(j for j in sweep.jobs if j.config["map"]["landmarks"] == 150).config["map"]
     assert sweep.name == "sweep" and sweep.salt == "" and sweep.replicates == 2
+
+
+def test_job_map_config_reads_words_and_numbers():
+    paper = expand_grid({"map": {"hop_cost": 0, "diffusion_time": "none", "wall_follow_weight": "none",
+                                 "window_length": "none"}}).jobs[0].config["map"]
+    config = job_map_config(paper, seed=3)
+    assert (config.hop_cost, config.diffusion_time, config.wall_follow_weight, config.window_length) == \
+        (0.0, float("inf"), None, float("inf"))
+    assert config.seed == 3 and config.embed_dim == 0 and not config.cycles
+    default = job_map_config(expand_grid({"map": {"wall_follow_weight": 1.5}}).jobs[0].config["map"])
+    assert (default.hop_cost, default.diffusion_time, default.wall_follow_weight, default.window_length) == \
+        (None, None, 1.5, None)
 
 
 def test_shapes_flat_list_is_one_set_and_list_of_lists_a_grid():
@@ -163,6 +175,7 @@ def test_keys_are_the_same_in_another_process():
     ("[map]\nlandmarks = 100\nmax_landmarks = 500", ["[map] max_landmarks", "landmarks is a number"]),
     ("[map]\nhop_cost = -2", ["[map] hop_cost = -2", '>= 0 or "auto"']),
     ("[map]\ndiffusion_time = 0", ["[map] diffusion_time = 0", '> 0 or "auto" or "none"']),
+    ("[map]\nwall_follow_weight = -1", ["[map] wall_follow_weight = -1", '>= 0 or "none"']),
     ("[map]\nwindow_length = 'all'", ['[map] window_length = "all"', '> 0 or "auto" or "none"']),
     ("[map]\nwindow_length = 20\nwindow_encounters = 30", ["[map] window_encounters", 'window_length is not "auto"']),
     ("[map]\nwindow_encounters = 0", ["[map] window_encounters = 0", "> 0"]),
@@ -195,7 +208,8 @@ def test_cli_bad_config_is_one_line_exit_1(tmp_path):
     proc = run_cli("sweep", path, "--store", tmp_path / "r.duckdb")
     assert proc.returncode == 1 and "Traceback" not in proc.stderr
     assert proc.stderr.strip().splitlines() == [f"error: {path}: [map] metrc: unknown key; expected one of "
-                                                "metric, hop_cost, diffusion_time, window_length, window_encounters, "
+                                                "metric, hop_cost, diffusion_time, wall_follow_weight, window_length, "
+                                                "window_encounters, "
                                                 "window_step, "
                                                 "subsample, landmarks, "
                                                 "max_landmarks, maxdim, classifier"]

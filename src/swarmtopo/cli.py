@@ -169,6 +169,19 @@ def _parse_window(text: Optional[str]):
     return tuple(None if e is None or math.isinf(e) else e for e in ends)
 
 
+def _parse_wall_follow_weight(text: Optional[str]):
+    """A --wall-follow-weight value: 'none' or a number >= 0."""
+    if text is None or text == "none":
+        return text
+    try:
+        value = float(text)
+    except ValueError:
+        raise typer.BadParameter(f"{text!r} is not a number or 'none'") from None
+    if not (math.isfinite(value) and value >= 0):
+        raise typer.BadParameter(f"{text!r} must be a number >= 0")
+    return text
+
+
 def _parse_seconds(text: Optional[str]):
     """A --window-length or --diffusion-time value: 'auto', 'none' or seconds > 0."""
     if text is None or text in ("auto", "none"):
@@ -205,18 +218,23 @@ def map_command(
         help="tau in seconds: a gap of w s between an agent's encounters weighs tau (sqrt(1 + 2 w / tau) - 1), "
              "about a random walk's displacement; 'none' = the paper's weight w; 'auto' (default) = half the mean "
              "time between an agent's encounters."),
+    wall_follow_weight: Optional[str] = typer.Option(
+        None, "--wall-follow-weight", callback=_parse_wall_follow_weight,
+        help="Seconds charged per second an agent spent wall following (status WF) within a gap, outside the "
+             "diffusive weights: along a wall an agent walks, it does not diffuse (default 2); 'none' = like any "
+             "other time (the paper)."),
     window_length: Optional[str] = typer.Option(
         None, "--window-length", callback=_parse_seconds,
         help="Seconds of the time windows whose maps vote; 'none' maps the whole log at once; 'auto' (default) "
-             "holds about 25 encounters per agent (25 x the mean time between an agent's encounters)."),
+             "holds about 20 encounters per agent (20 x the mean time between an agent's encounters)."),
     classifier: Optional[str] = typer.Option(
         None, "--classifier",
         help="Betti classifier: default (tuned on the accuracy benchmark), paper-form (the paper's form trained "
              "our way), paper (the paper's Theta*), or a JSON file."),
     paper: bool = typer.Option(
         False, "--paper",
-        help="Run exactly the paper's pipeline: no per-hop cost, no diffusive weights, the whole log, the "
-             "paper's Theta*."),
+        help="Run exactly the paper's pipeline: no per-hop cost, no diffusive weights, wall following like any "
+             "time, the whole log, the paper's Theta*."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
@@ -228,16 +246,19 @@ def map_command(
     _check_verbosity(quiet, verbose)
     if paper:
         given = [name for name, value in (("--hop-cost", hop_cost), ("--diffusion-time", diffusion_time),
+                                          ("--wall-follow-weight", wall_follow_weight),
                                           ("--window-length", window_length), ("--classifier", classifier))
                  if value is not None]
         if given:
             raise typer.BadParameter(f"--paper fixes {', '.join(given)}; drop one or the other")
-        hop_cost, diffusion_time, window_length, classifier = 0.0, "none", "none", "paper"
+        hop_cost, diffusion_time, wall_follow_weight, window_length, classifier = 0.0, "none", "none", "none", "paper"
     out_dir = out_dir or log_dir / "map"
     model = load_classifier(classifier or "default")
     log = read_log(log_dir)
     config = MapConfig(metric=metric, subsample=subsample, landmarks=landmarks, window=window, maxdim=maxdim,
                        seed=seed, hop_cost=hop_cost, diffusion_time=seconds_option(diffusion_time),
+                       wall_follow_weight=(MapConfig.wall_follow_weight if wall_follow_weight is None
+                                           else None if wall_follow_weight == "none" else float(wall_follow_weight)),
                        window_length=seconds_option(window_length))
     if verbose:
         _detail(f"log {log_dir}: {log.n_events} encounters of {log.n_agents} agents over {log.duration:g} s")
@@ -518,7 +539,8 @@ def _map_details(tmap) -> None:
                     f"{[w.betti.get(1) for w in r.windows]} holes; vote {r.betti.get(1)}, shown: window "
                     f"{r.window} [{r.windows[r.window].t0:.1f}, {r.windows[r.window].t1:.1f}] s")
     _detail(f"per-hop cost h = {tmap.hop_cost[0]:.3g} s ({tmap.hop_cost[1]}); diffusion time "
-            f"{tmap.diffusion_time[0]:.3g} s ({tmap.diffusion_time[1]}); window "
+            f"{tmap.diffusion_time[0]:.3g} s ({tmap.diffusion_time[1]}); wall following "
+            f"{'like any time' if tmap.config.wall_follow_weight is None else f'x {tmap.config.wall_follow_weight:g}'}; window "
             f"{tmap.window_length[0]:.3g} s ({tmap.window_length[1]})")
 
 

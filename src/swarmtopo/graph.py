@@ -81,6 +81,22 @@ displacement, not its duration.  D_tau is subadditive, so it applies to the chai
 consecutive gaps: the claim above does not carry over, and this metric, like the
 per-hop cost, lives on the chain graph C.
 
+Wall-following time (swarmtopo's variant, not the paper's)
+----------------------------------------------------------
+With ``wall_follow_weight`` c (a number >= 0), the part w_WF of a chain gap that the
+agent spent wall following (status WF, from its status changes; a state lasts until
+the agent's next change, and before its first change counts as not WF) is taken out
+of the diffusive compression and charged linearly::
+
+    w -> D_tau(w - w_WF) + c w_WF        (then + h)
+
+A wall-following agent walks along a wall, not at random, so its displacement grows
+with the time itself, not with its square root; compressing it as a random walk's
+would shorten exactly the paths that go round an obstacle.  c = None (default here)
+charges w_WF like any other time (the paper's weight for tau = inf); a log without
+status changes has w_WF = 0.  Each gap is charged on its own, so this metric too
+lives on the chain graph C.
+
 Zero weights and merged nodes
 -----------------------------
 Zero-weight chain edges (stop intervals, static agents, equal times) are contracted
@@ -105,7 +121,7 @@ from scipy.sparse.csgraph import connected_components, csgraph_from_dense, dijks
 
 from ._validate import non_negative, positive
 from .errors import InputError
-from .log import EncounterLog
+from .log import WF, EncounterLog
 
 METRICS: tuple[str, ...] = ("plain", "contracted", "hybrid")
 """Encounter metrics: paper's plain encounter metric, contracted, hybrid network."""
@@ -217,7 +233,8 @@ class EncounterGraph:
 
 def build_graph(log: EncounterLog, metric: str = "plain", *,
                 window: tuple[float | None, float | None] | None = None,
-                hop_cost: float = 0.0, diffusion_time: float = np.inf) -> EncounterGraph:
+                hop_cost: float = 0.0, diffusion_time: float = np.inf,
+                wall_follow_weight: float | None = None) -> EncounterGraph:
     """Sparse chain graph of the events of ``log`` under an encounter metric.
 
     Parameters
@@ -237,6 +254,10 @@ def build_graph(log: EncounterLog, metric: str = "plain", *,
     diffusion_time
         tau > 0, seconds: chain gaps w weigh D_tau(w) (see "Diffusive gaps" in the module
         docstring); inf (default) is the paper's weight w.
+    wall_follow_weight
+        c >= 0: the wall-following part of each gap weighs c per second, outside D_tau
+        (see "Wall-following time" in the module docstring); None (default) does not
+        separate it, the paper's weight.
 
     Returns
     -------
@@ -247,11 +268,19 @@ def build_graph(log: EncounterLog, metric: str = "plain", *,
     Raises
     ------
     InputError
-        Unknown metric, no events (in the window), a negative hop cost or a diffusion
-        time that is not > 0.
+        Unknown metric, no events (in the window), a negative hop cost, a diffusion
+        time that is not > 0 or a negative wall-following weight.
     """
     chains = chain_edges(log, metric, window)
-    weight = diffusive_weight(chains.weight, diffusion_time) + non_negative("hop cost", hop_cost)
+    hop_cost = non_negative("hop cost", hop_cost)
+    if wall_follow_weight is None:
+        weight = diffusive_weight(chains.weight, diffusion_time)
+    else:
+        c = non_negative("wall-following weight", wall_follow_weight)
+        following = np.minimum(state_time(log, WF, chains.agent, chains.t[chains.first], chains.t[chains.second]),
+                               chains.weight)
+        weight = diffusive_weight(chains.weight - following, diffusion_time) + c * following
+    weight = weight + hop_cost
     return _contract(chains.t, chains.first, chains.second, weight, chains.event_index, metric)
 
 
@@ -291,6 +320,39 @@ def chain_edges(log: EncounterLog, metric: str = "plain",
     if intervals is not None and len(intervals[0]):
         weight[_within_one_interval(pair_agent, t[first], t[second], intervals, log.n_agents)] = 0.0
     return ChainEdges(pair_agent, first, second, weight, t, np.arange(start, stop, dtype=np.int64))
+
+
+def state_time(log: EncounterLog, state: int, agent: np.ndarray, t0: np.ndarray, t1: np.ndarray) -> np.ndarray:
+    """Seconds each ``agent[i]`` spent in status ``state`` (a code into
+    :data:`~swarmtopo.log.STATES`) between ``t0[i] <= t1[i]``, from its status changes: a
+    state lasts until the agent's next change (the last one for ever); before the
+    agent's first change it counts as no state."""
+    rows_agent, rows_t = log.status_agent, log.status_t  # sorted by (agent, t)
+    offsets = _group_offsets(rows_agent, log.n_agents)
+    same_next = np.r_[rows_agent[1:] == rows_agent[:-1], False]
+    in_state = (log.status_state == state).astype(np.float64)
+    spent = np.where(same_next, np.r_[rows_t[1:], 0.0] - rows_t, 0.0) * in_state
+    # time in the state before each row: the agent's running sum of the rows before it
+    running = np.cumsum(spent) - spent
+    before = running - running[offsets[rows_agent]]
+    out = np.empty(len(agent))
+    _state_time(np.asarray(agent, np.int64), np.asarray(t0, np.float64), np.asarray(t1, np.float64),
+                offsets, rows_t, before, in_state, out)
+    return out
+
+
+@njit(cache=True)
+def _state_time(agent, t0, t1, offsets, rows_t, before, in_state, out):
+    for p in range(len(agent)):
+        out[p] = (_time_in_state_by(t1[p], offsets[agent[p]], offsets[agent[p] + 1], rows_t, before, in_state)
+                  - _time_in_state_by(t0[p], offsets[agent[p]], offsets[agent[p] + 1], rows_t, before, in_state))
+
+
+@njit(cache=True)
+def _time_in_state_by(t, lo, hi, rows_t, before, in_state):
+    """Time in the state from the agent's first status row (rows lo..hi-1) up to t."""
+    j = lo + np.searchsorted(rows_t[lo:hi], t, side="right") - 1
+    return before[j] + in_state[j] * (t - rows_t[j]) if j >= lo else 0.0
 
 
 def agent_gaps(log: EncounterLog) -> np.ndarray:

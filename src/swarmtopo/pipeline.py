@@ -55,6 +55,9 @@ between an agent's consecutive encounters (docs/accuracy.md, "Real traces")."""
 DIFFUSION_GAP_FACTOR = 0.5
 """The automatic diffusion time tau is this many times the mean time between an agent's
 consecutive encounters (docs/tuning.md)."""
+WALL_FOLLOW_WEIGHT = 2.0
+"""Default ``MapConfig.wall_follow_weight``: seconds charged per second of wall following
+inside a chain gap, outside the diffusive compression (docs/tuning.md)."""
 WHOLE_LOG = float("inf")
 """``MapConfig.window_length`` that maps the whole log at once (the paper)."""
 
@@ -93,6 +96,11 @@ class MapConfig:
         about a random walk's displacement, not its duration.  inf is the paper's
         weight; None (default) is ``DIFFUSION_GAP_FACTOR`` x the mean time between an
         agent's consecutive encounters in the mapped events (:func:`resolve_diffusion_time`).
+    wall_follow_weight
+        c: the part of a chain gap an agent spent wall following (status WF) weighs c
+        per second, outside D_tau: along a wall an agent walks, it does not diffuse
+        (:mod:`swarmtopo.graph`).  Default ``WALL_FOLLOW_WEIGHT``; None charges it like
+        any other time (the paper).  A log without status changes is unaffected.
     window_length
         Length (s) of the time windows each region is mapped in; the region's Betti
         numbers are voted across them (:func:`swarmtopo.ratio.vote`).  None (default):
@@ -102,7 +110,7 @@ class MapConfig:
         (inf) maps the whole log at once (the paper); so does any length not shorter
         than the log.
     window_encounters
-        K, the encounters per agent an automatic window holds (default 25, chosen on
+        K, the encounters per agent an automatic window holds (default 20, chosen on
         the benchmark's tuning cases: docs/tuning.md).
     window_step
         Seconds between the starts of consecutive windows; None (default) = half the
@@ -144,8 +152,9 @@ class MapConfig:
     metric: str = "hybrid"
     hop_cost: float | None = None
     diffusion_time: float | None = None
+    wall_follow_weight: float | None = WALL_FOLLOW_WEIGHT
     window_length: float | None = None
-    window_encounters: float = 25.0
+    window_encounters: float = 20.0
     window_step: float | None = None
     subsample: str = "maxmin"
     landmarks: int | None = None
@@ -175,6 +184,9 @@ class MapConfig:
         if self.diffusion_time is not None and not self.diffusion_time > 0:
             raise SwarmtopoError(f"diffusion_time must be a positive number of seconds or inf, got "
                                  f"{self.diffusion_time}")
+        if self.wall_follow_weight is not None and not (np.isfinite(self.wall_follow_weight)
+                                                        and self.wall_follow_weight >= 0):
+            raise SwarmtopoError(f"wall_follow_weight must be a number >= 0 or None, got {self.wall_follow_weight}")
         if self.window_length is not None and not self.window_length > 0:
             raise SwarmtopoError(f"window_length must be a positive number of seconds, got {self.window_length}")
         if not (np.isfinite(self.window_encounters) and self.window_encounters > 0):
@@ -378,7 +390,8 @@ def map_encounters(
     mapped = log if config.window is None else log.window(*config.window)
     agent_gap = mean_agent_gap(mapped)
     diffusion_time, diffusion_source = resolve_diffusion_time(agent_gap, config.diffusion_time)
-    graph = build_graph(log, config.metric, window=config.window, hop_cost=hop_cost, diffusion_time=diffusion_time)
+    graph = build_graph(log, config.metric, window=config.window, hop_cost=hop_cost, diffusion_time=diffusion_time,
+                        wall_follow_weight=config.wall_follow_weight)
     n_comp, labels = graph.components()
     event_comp = labels[graph.node_of_event]
     events_per_comp = np.bincount(event_comp, minlength=n_comp)
@@ -404,7 +417,7 @@ def map_encounters(
         for span in spans:
             if _events_within(log, span) >= config.min_region_events:  # a gap in a real trace is skipped
                 wgraph = build_graph(log, config.metric, window=span, hop_cost=hop_cost,
-                                     diffusion_time=diffusion_time)
+                                     diffusion_time=diffusion_time, wall_follow_weight=config.wall_follow_weight)
                 window_graphs.append((span, wgraph, wgraph.components()[1]))
     regions: list[RegionMap] = []
     for comp, n_land in zip(regions_idx, shares):

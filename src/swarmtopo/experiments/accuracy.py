@@ -60,10 +60,11 @@ SLICE_PER_CELL = 2
 TUNING_PER_CELL = 12
 
 PIPELINES: dict[str, dict[str, Any]] = {
-    "default": {"metric": "hybrid", "hop_cost": "auto", "diffusion_time": "auto", "window_length": "auto",
+    "default": {"metric": "hybrid", "hop_cost": "auto", "diffusion_time": "auto",
+                "wall_follow_weight": MapConfig.wall_follow_weight, "window_length": "auto",
                 "window_encounters": MapConfig.window_encounters, "window_step": "auto", "classifier": "default"},
-    "paper": {"metric": "hybrid", "hop_cost": 0.0, "diffusion_time": "none", "window_length": "none",
-              "classifier": "paper-form"},
+    "paper": {"metric": "hybrid", "hop_cost": 0.0, "diffusion_time": "none", "wall_follow_weight": "none",
+              "window_length": "none", "classifier": "paper-form"},
 }
 """The pipelines the benchmark compares: swarmtopo's default, and the best
 configuration of the paper's own methods (its metric and subsampler, whole log, its

@@ -33,8 +33,8 @@ HOLES = (0, 1, 2, 3)
 RUNS = 100
 """Environments per set (paper: 100)."""
 CLUST_SWARM = {"agents": 200, "duration": 30.0}
-CLUST_MAP = {"metric": "contracted", "hop_cost": 0.0, "diffusion_time": "none", "window_length": "none",
-             "subsample": "maxmin", "landmarks": 300, "classifier": "paper-form"}
+CLUST_MAP = {"metric": "contracted", "hop_cost": 0.0, "diffusion_time": "none", "wall_follow_weight": "none",
+             "window_length": "none", "subsample": "maxmin", "landmarks": 300, "classifier": "paper-form"}
 CLUST_ARENA = {"generator": "random", "shapes": "square", "outer": "square"}
 
 

@@ -28,9 +28,11 @@ Format (``examples/sweep-small.toml`` is a commented example)::
     hop_cost = "auto"         # per-hop cost h, s: a number >= 0 (0 = the paper) or "auto" (default)
     diffusion_time = "auto"   # tau of the diffusive chain weights, s: a number > 0, "auto" (default:
                               # half the mean time between an agent's encounters) or "none" (the paper)
+    wall_follow_weight = 2.0  # s charged per s of wall following in a gap, outside the diffusive
+                              # weights: a number >= 0 (default 2) or "none" (like any time, the paper)
     window_length = "auto"    # windows voted over, s: a number > 0, "auto" (default: window_encounters
                               # encounters per agent) or "none" (whole log, the paper)
-    window_encounters = 25.0  # K of automatic windows (only with window_length = "auto")
+    window_encounters = 20.0  # K of automatic windows (only with window_length = "auto")
     window_step = "auto"      # s between window starts: a number > 0 or "auto" (half the length)
     subsample = "maxmin"      # maxmin | knn | probabilistic (default maxmin)
     landmarks = "auto"        # an integer L >= 3, or "auto" (default)
@@ -191,6 +193,8 @@ PARAMS: tuple[Param, ...] = (
     Param("map", "metric", "hybrid", _choice(METRICS), "TEXT"),
     Param("map", "hop_cost", "auto", _or_word("auto", _number(0.0, strict=False)), "DOUBLE"),
     Param("map", "diffusion_time", "auto", _or_word(("auto", "none"), _number(0.0, strict=True)), "DOUBLE"),
+    Param("map", "wall_follow_weight", MapConfig().wall_follow_weight, _or_word("none", _number(0.0, strict=False)),
+          "DOUBLE"),
     Param("map", "window_length", "auto", _or_word(("auto", "none"), _number(0.0, strict=True)), "DOUBLE"),
     Param("map", "window_encounters", MapConfig().window_encounters, _number(0.0, strict=True), "DOUBLE"),
     Param("map", "window_step", "auto", _or_word("auto", _number(0.0, strict=True)), "DOUBLE"),
@@ -383,9 +387,9 @@ def expand_grid(document: dict, *, source: str = "<grid>", base_dir=None,
 
 def flat_columns(config: dict) -> dict[str, Any]:
     """One value per ``PARAMS`` key: None where the config does not use it and for "auto"
-    (from the data), inf for "none" in a number column (``diffusion_time`` and
-    ``window_length``: the paper's weights, the whole log): the store's flattened grid
-    columns."""
+    (from the data), inf for "none" in a number column (``diffusion_time``,
+    ``wall_follow_weight`` and ``window_length``: the paper's weights, the whole log): the
+    store's flattened grid columns."""
     flat = {}
     for p in PARAMS:
         value = config.get(p.table, {}).get(p.name)
@@ -469,7 +473,8 @@ def _canonical(point: dict, inputs: _InputFiles, fail):
                  f"after the end of the run (duration = {swarm['duration']:g} s)")
 
     mapping = {name: point[("map", name)]
-               for name in ("metric", "hop_cost", "diffusion_time", "window_length", "subsample", "landmarks",
+               for name in ("metric", "hop_cost", "diffusion_time", "wall_follow_weight", "window_length",
+                            "subsample", "landmarks",
                             "maxdim", "classifier")}
     if mapping["window_length"] != "none":
         mapping["window_step"] = point[("map", "window_step")]

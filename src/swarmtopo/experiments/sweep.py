@@ -96,11 +96,13 @@ def stripped_log(log: EncounterLog) -> EncounterLog:
 
 def job_map_config(mapping: dict[str, Any], seed: int | None = None) -> MapConfig:
     """The ``MapConfig`` of a job's canonical ``[map]`` table ("auto" -> None, from the
-    data; "none" -> inf), as sweeps map: no picture, no loops."""
+    data; "none" -> inf, except a "none" wall-following weight -> None), as sweeps map:
+    no picture, no loops."""
     return MapConfig(
         metric=mapping["metric"], subsample=mapping["subsample"],
         hop_cost=seconds_option(mapping["hop_cost"]),
         diffusion_time=seconds_option(mapping["diffusion_time"]),
+        wall_follow_weight=None if mapping["wall_follow_weight"] == "none" else float(mapping["wall_follow_weight"]),
         window_length=seconds_option(mapping["window_length"]),
         window_encounters=mapping.get("window_encounters", MapConfig.window_encounters),
         window_step=seconds_option(mapping.get("window_step")),
