@@ -37,6 +37,10 @@ diffusion time, wall following x 2):
   d~(l_i, l_j) = (A_ij + A_ji) / 2 with A_ij the mean (HOW = ``mean``) or median
   (``median``) of d(l_i, y) over the K nodes y nearest l_j, or that mean minus their
   mean distance to l_j (``meanc``): a denoiser of each landmark's own distortion.
+* ``paths-C`` -- landmarks and Vietoris-Rips on the window's chain graph with every
+  edge cut into pieces of at most C x its k-NN scale: points along the agents' paths
+  between two encounters (event-to-event distances unchanged), so landmarks can sit
+  where agents passed without meeting.
 * ``mds-D`` -- Vietoris-Rips on the landmarks' classical MDS coordinates in R^D (the
   projection on the top D eigenvectors as a denoiser) instead of their metric.
 * ``FIELD=VALUE`` -- ``MapConfig(FIELD=VALUE)`` (e.g. ``subsample=knn``, ``metric=plain``).
@@ -221,6 +225,50 @@ def _smooth(log, seed, how, k):
         sub.distances_from(window.landmarks.nodes), k, how))
 
 
+def _subdivided(graph, step: float):
+    """``graph`` with every edge longer than ``step`` cut into ceil(w / step) equal
+    pieces by new nodes (multiplicity 1): points of the agents' paths between two
+    encounters, so the event-to-event metric is unchanged."""
+    upper = sparse.triu(graph.adjacency, k=1).tocoo()
+    u, v, w = upper.row.astype(np.int64), upper.col.astype(np.int64), upper.data
+    pieces = np.maximum(np.ceil(w / step - 1e-9).astype(np.int64), 1)
+    first_new = graph.n_nodes + np.cumsum(pieces - 1) - (pieces - 1)
+    edge = np.repeat(np.arange(len(w)), pieces)
+    j = np.arange(len(edge)) - np.repeat(np.cumsum(pieces) - pieces, pieces)
+    a = np.where(j == 0, u[edge], first_new[edge] + j - 1)
+    b = np.where(j == pieces[edge] - 1, v[edge], first_new[edge] + j)
+    n = graph.n_nodes + int((pieces - 1).sum())
+    half = sparse.csr_matrix((w[edge] / pieces[edge], (a, b)), shape=(n, n))
+    adjacency = (half + half.T).tocsr()
+    adjacency.sort_indices()
+    return dataclasses.replace(graph, adjacency=adjacency,
+                               multiplicity=np.r_[graph.multiplicity, np.ones(n - graph.n_nodes, np.int64)])
+
+
+def _trajectory(log, seed, factor):
+    """Landmarks and Rips on the chain graph's edges cut every ``factor`` x the window's
+    k-NN scale s (virtual points along the agents' paths); landmarks cover to 1.5 s as
+    by default."""
+    original = P._map_window
+
+    def window_on_paths(span, sub, n_land, config, rng, timings, say):
+        knn_scale = P._knn_scale(sub, config.knn_k)
+        dense = _subdivided(sub, factor * knn_scale)
+        land = P._subsample(dense, config, min(config.max_landmarks, dense.n_nodes), rng)
+        land = P._first_covering(land, P.AUTO_COVER_FACTOR * knn_scale)
+        persistence = rips_persistence(land.distances, maxdim=config.maxdim)
+        return P.WindowMap(t0=0.0, t1=0.0, n_events=sub.n_events, landmarks=land,
+                           landmark_events=np.zeros(len(land.nodes), np.int64),
+                           scales=P.RegionScales(knn=knn_scale, cover_radius=float(land.cover_radius)),
+                           persistence=persistence)
+
+    P._map_window = window_on_paths
+    try:
+        return _windows_of(log, seed)
+    finally:
+        P._map_window = original
+
+
 def _override(text):
     """The variant ``FIELD=VALUE``: MapConfig(FIELD=VALUE), VALUE read as the field's default's type."""
     field, value = text.split("=", 1)
@@ -238,6 +286,8 @@ def _variant(name):
     if name.startswith("smooth-"):
         _, how, k = name.split("-")
         return lambda log, seed: _smooth(log, seed, how, int(k))
+    if name.startswith("paths-"):
+        return lambda log, seed: _trajectory(log, seed, float(name.split("-", 1)[1]))
     if name.startswith("mds-"):
         return lambda log, seed: _mds(log, seed, int(name.split("-", 1)[1]))
     if name.startswith("log-"):
@@ -303,7 +353,7 @@ def main() -> None:
     parser.add_argument("--per-cell", type=int, default=12)
     parser.add_argument("--variants", nargs="+", default=["default", "20s", "whole", "quarter", "draws", "switch"],
                         help=f"{', '.join(sorted(VARIANTS))}, diffusive-C, switch-C, log-C, wall-C, wall-none, "
-                             "smooth-HOW-K, mds-D or FIELD=VALUE")
+                             "smooth-HOW-K, paths-C, mds-D or FIELD=VALUE")
     parser.add_argument("--cells", nargs="+", metavar="TEXT",
                         help="only the cells whose name contains one of these (default: all)")
     parser.add_argument("--processes", type=int, default=2)
