@@ -41,13 +41,18 @@ diffusion time, wall following x 2):
   edge cut into pieces of at most C x its k-NN scale: points along the agents' paths
   between two encounters (event-to-event distances unchanged), so landmarks can sit
   where agents passed without meeting.
+* ``dtm-K`` -- the DTM-filtration of the landmarks (p = 1, Anai et al. 2019) instead of
+  Vietoris-Rips: l_i enters at f_i, the root mean square of its distances to its K
+  nearest nodes, and edge ij at max(f_i, f_j, (f_i + f_j + d_ij) / 2), so landmarks
+  where few encounters happen enter late.
 * ``mds-D`` -- Vietoris-Rips on the landmarks' classical MDS coordinates in R^D (the
   projection on the top D eigenvectors as a denoiser) instead of their metric.
 * ``FIELD=VALUE`` -- ``MapConfig(FIELD=VALUE)`` (e.g. ``subsample=knn``, ``metric=plain``).
 * ``log-C`` -- chain gaps compressed logarithmically instead, tau ln(1 + w / tau), with
   tau = C x the mean time between an agent's encounters.
 * ``mix`` -- the windows of K = 15 and 25 encounters per agent and the whole log, all
-  in one vote; ``mix-20-25-30`` those of K = 20, 25 and 30.
+  in one vote; ``mix-K1-K2-...`` those of K1, K2, ..., and ``mix-K1-...-whole`` with
+  the whole log too.
 * ``witness`` -- lazy witness complex (nu = 1) on the landmarks with every event of the
   window as a witness, instead of Vietoris-Rips: edge (i, j) enters at
   min_w max(d(w, l_i), d(w, l_j)) - m_w, m_w the distance of w to its nearest landmark.
@@ -77,7 +82,7 @@ from swarmtopo.experiments.accuracy import CELLS, case, tuning_session
 from swarmtopo.experiments.grid import case_streams
 from swarmtopo.experiments.sweep import build_arena, stripped_log
 from swarmtopo.experiments.tuning import TuningMap, exact, fit_thresholds
-from swarmtopo.persistence import rips_persistence
+from swarmtopo.persistence import Diagram, rips_persistence
 from swarmtopo.pipeline import WHOLE_LOG, MapConfig, map_encounters, mean_agent_gap, resolve_window
 from swarmtopo.ratio import WindowBars
 from swarmtopo.sim import simulate
@@ -225,6 +230,39 @@ def _smooth(log, seed, how, k):
         sub.distances_from(window.landmarks.nodes), k, how))
 
 
+def _dtm_persistence(to_nodes: np.ndarray, distances: np.ndarray, k: int, maxdim: int):
+    """DTM-filtration (p = 1; Anai et al. 2019) of the landmarks: l_i enters at
+    f_i = DTM_k(l_i), the root mean square of its distances to its K nearest nodes, and
+    edge ij at max(f_i, f_j, (f_i + f_j + d_ij) / 2); ripser.py reads a sparse matrix's
+    diagonal as the vertices' values."""
+    from ripser import ripser
+
+    near = np.partition(to_nodes, min(k, to_nodes.shape[1]) - 1, axis=1)[:, :k]
+    f = np.sqrt((near ** 2).mean(axis=1))
+    values = np.maximum(np.maximum(f[:, None], f[None, :]), (f[:, None] + f[None, :] + distances) / 2)
+    np.fill_diagonal(values, f)
+    out = ripser(sparse.coo_matrix(values), maxdim=maxdim, distance_matrix=True)
+    pairs = [np.asarray(d, float).reshape(-1, 2) for d in out["dgms"]]
+    return P.PersistenceResult(Diagram(tuple(pairs), "ripser"), None, "ripser", 0.0)
+
+
+def _dtm(log, seed, k):
+    """Map with the DTM-filtration of each window's landmarks instead of Vietoris-Rips."""
+    original = P._map_window
+
+    def window_with_dtm(span, sub, n_land, config, rng, timings, say):
+        window = original(span, sub, n_land, config, rng, timings, say)
+        persistence = _dtm_persistence(sub.distances_from(window.landmarks.nodes), window.landmarks.distances,
+                                       k, config.maxdim)
+        return dataclasses.replace(window, persistence=persistence)
+
+    P._map_window = window_with_dtm
+    try:
+        return _windows_of(log, seed)
+    finally:
+        P._map_window = original
+
+
 def _subdivided(graph, step: float):
     """``graph`` with every edge longer than ``step`` cut into ceil(w / step) equal
     pieces by new nodes (multiplicity 1): points of the agents' paths between two
@@ -288,6 +326,13 @@ def _variant(name):
         return lambda log, seed: _smooth(log, seed, how, int(k))
     if name.startswith("paths-"):
         return lambda log, seed: _trajectory(log, seed, float(name.split("-", 1)[1]))
+    if name.startswith("mix-"):
+        parts = name.split("-")[1:]
+        whole = parts[-1] == "whole"
+        encounters = tuple(float(k) for k in parts[:len(parts) - whole])
+        return lambda log, seed: _window_mix(log, seed, encounters, whole=whole)
+    if name.startswith("dtm-"):
+        return lambda log, seed: _dtm(log, seed, int(name.split("-", 1)[1]))
     if name.startswith("mds-"):
         return lambda log, seed: _mds(log, seed, int(name.split("-", 1)[1]))
     if name.startswith("log-"):
@@ -325,7 +370,6 @@ VARIANTS = {
     "hop-double": _hop_times(2.0),
     "dense": _dense,
     "mix": _window_mix,
-    "mix-20-25-30": lambda log, seed: _window_mix(log, seed, (20.0, 25.0, 30.0), whole=False),
 }
 
 
@@ -353,7 +397,7 @@ def main() -> None:
     parser.add_argument("--per-cell", type=int, default=12)
     parser.add_argument("--variants", nargs="+", default=["default", "20s", "whole", "quarter", "draws", "switch"],
                         help=f"{', '.join(sorted(VARIANTS))}, diffusive-C, switch-C, log-C, wall-C, wall-none, "
-                             "smooth-HOW-K, paths-C, mds-D or FIELD=VALUE")
+                             "smooth-HOW-K, paths-C, dtm-K, mds-D, mix-K1-K2[-whole] or FIELD=VALUE")
     parser.add_argument("--cells", nargs="+", metavar="TEXT",
                         help="only the cells whose name contains one of these (default: all)")
     parser.add_argument("--processes", type=int, default=2)

@@ -28,3 +28,17 @@ def test_paths_cut_every_edge_and_keep_event_distances():
     before = graph.distances_from(sources)
     after = cut.distances_from(sources)[:, :graph.n_nodes]
     np.testing.assert_allclose(after, before, rtol=1e-12, atol=1e-9)
+
+
+def test_dtm_filtration_of_a_square_by_hand():
+    # four landmarks on a unit square; each has its nearest node at 0 and the next at
+    # c sqrt(2), so with K = 2 every f_i = sqrt((0 + 2 c^2) / 2) = c
+    c = 0.3
+    side, diagonal = 1.0, np.sqrt(2.0)
+    distances = np.array([[0, side, diagonal, side], [side, 0, side, diagonal],
+                          [diagonal, side, 0, side], [side, diagonal, side, 0]])
+    to_nodes = np.array([[0.0, c * np.sqrt(2.0), 5.0]] * 4)
+    diagram = levers._dtm_persistence(to_nodes, distances, 2, 1).diagram
+    # equal weights: vertices enter at c, an edge of length d at c + d / 2
+    np.testing.assert_allclose(diagram[0][np.isfinite(diagram[0][:, 1])], [[c, c + side / 2]] * 3)
+    np.testing.assert_allclose(diagram[1], [[c + side / 2, c + diagonal / 2]])
