@@ -165,21 +165,27 @@ def _witness_filtration(to_nodes: np.ndarray) -> np.ndarray:
     return values
 
 
-def _other_filtration(log, seed, values_of):
-    """Map with Vietoris-Rips on ``values_of(window, sub)`` (an L x L matrix from a
-    window's landmarks and its graph) instead of the landmarks' metric."""
+def _other_persistence(log, seed, persistence_of):
+    """Map with ``persistence_of(window, sub, maxdim)`` (a PersistenceResult from a
+    window's landmarks and its graph) instead of Vietoris-Rips on the landmarks' metric."""
     original = P._map_window
 
-    def window_with_other_filtration(span, sub, n_land, config, rng, timings, say):
+    def window_with_other_persistence(span, sub, n_land, config, rng, timings, say):
         window = original(span, sub, n_land, config, rng, timings, say)
-        values = values_of(window, sub)
-        return dataclasses.replace(window, persistence=rips_persistence(values, maxdim=config.maxdim))
+        return dataclasses.replace(window, persistence=persistence_of(window, sub, config.maxdim))
 
-    P._map_window = window_with_other_filtration
+    P._map_window = window_with_other_persistence
     try:
         return _windows_of(log, seed)
     finally:
         P._map_window = original
+
+
+def _other_filtration(log, seed, values_of):
+    """Map with Vietoris-Rips on ``values_of(window, sub)`` (an L x L matrix from a
+    window's landmarks and its graph) instead of the landmarks' metric."""
+    return _other_persistence(log, seed, lambda window, sub, maxdim: rips_persistence(values_of(window, sub),
+                                                                                      maxdim=maxdim))
 
 
 def _witness(log, seed):
@@ -248,19 +254,8 @@ def _dtm_persistence(to_nodes: np.ndarray, distances: np.ndarray, k: int, maxdim
 
 def _dtm(log, seed, k):
     """Map with the DTM-filtration of each window's landmarks instead of Vietoris-Rips."""
-    original = P._map_window
-
-    def window_with_dtm(span, sub, n_land, config, rng, timings, say):
-        window = original(span, sub, n_land, config, rng, timings, say)
-        persistence = _dtm_persistence(sub.distances_from(window.landmarks.nodes), window.landmarks.distances,
-                                       k, config.maxdim)
-        return dataclasses.replace(window, persistence=persistence)
-
-    P._map_window = window_with_dtm
-    try:
-        return _windows_of(log, seed)
-    finally:
-        P._map_window = original
+    return _other_persistence(log, seed, lambda window, sub, maxdim: _dtm_persistence(
+        sub.distances_from(window.landmarks.nodes), window.landmarks.distances, k, maxdim))
 
 
 def _subdivided(graph, step: float):
@@ -319,8 +314,7 @@ def _variant(name):
     if "=" in name:
         return _override(name)
     if name.startswith("wall-"):
-        value = name.split("-", 1)[1]
-        return lambda log, seed: _windows_of(log, seed, wall_follow_weight=None if value == "none" else float(value))
+        return lambda log, seed: _windows_of(log, seed, wall_follow_weight=P.wall_follow_option(name.split("-", 1)[1]))
     if name.startswith("smooth-"):
         _, how, k = name.split("-")
         return lambda log, seed: _smooth(log, seed, how, int(k))

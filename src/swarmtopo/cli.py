@@ -241,7 +241,7 @@ def map_command(
     """Map an encounter log folder: Betti numbers with confidence, diagrams and pictures."""
     from .classify import load_classifier
     from .io import read_log
-    from .pipeline import MapConfig, seconds_option
+    from .pipeline import MapConfig, seconds_option, wall_follow_option
 
     _check_verbosity(quiet, verbose)
     if paper:
@@ -257,8 +257,7 @@ def map_command(
     log = read_log(log_dir)
     config = MapConfig(metric=metric, subsample=subsample, landmarks=landmarks, window=window, maxdim=maxdim,
                        seed=seed, hop_cost=hop_cost, diffusion_time=seconds_option(diffusion_time),
-                       wall_follow_weight=(MapConfig.wall_follow_weight if wall_follow_weight is None
-                                           else None if wall_follow_weight == "none" else float(wall_follow_weight)),
+                       wall_follow_weight=wall_follow_option(wall_follow_weight),
                        window_length=seconds_option(window_length))
     if verbose:
         _detail(f"log {log_dir}: {log.n_events} encounters of {log.n_agents} agents over {log.duration:g} s")

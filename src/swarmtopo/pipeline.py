@@ -71,6 +71,15 @@ def seconds_option(value: str | float | None) -> float | None:
     return WHOLE_LOG if value == "none" else float(value)
 
 
+def wall_follow_option(value: str | float | None) -> float | None:
+    """``MapConfig.wall_follow_weight`` from a command-line or sweep value: None -> the
+    default (``WALL_FOLLOW_WEIGHT``), "none" -> None (charged like any time, the paper), a
+    number -> that weight."""
+    if value is None:
+        return WALL_FOLLOW_WEIGHT
+    return None if value == "none" else float(value)
+
+
 STAGES = ("graph", "landmarks", "persistence", "embedding", "classify", "cycles")
 """Stage names passed to ``map_encounters``'s progress callback, in order."""
 

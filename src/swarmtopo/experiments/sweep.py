@@ -37,7 +37,7 @@ from ..errors import SwarmtopoError
 from ..io import GROUND_TRUTH_META_KEYS, read_arena, read_log, write_log
 from ..log import EncounterLog
 from ..persistence import snr
-from ..pipeline import MapConfig, map_encounters, software_versions, seconds_option
+from ..pipeline import MapConfig, map_encounters, seconds_option, software_versions, wall_follow_option
 from ..sim import simulate
 from .grid import Job, flat_columns
 from .store import JOB_COLUMNS, ResultStore
@@ -102,7 +102,7 @@ def job_map_config(mapping: dict[str, Any], seed: int | None = None) -> MapConfi
         metric=mapping["metric"], subsample=mapping["subsample"],
         hop_cost=seconds_option(mapping["hop_cost"]),
         diffusion_time=seconds_option(mapping["diffusion_time"]),
-        wall_follow_weight=None if mapping["wall_follow_weight"] == "none" else float(mapping["wall_follow_weight"]),
+        wall_follow_weight=wall_follow_option(mapping["wall_follow_weight"]),
         window_length=seconds_option(mapping["window_length"]),
         window_encounters=mapping.get("window_encounters", MapConfig.window_encounters),
         window_step=seconds_option(mapping.get("window_step")),
