@@ -52,7 +52,8 @@ diffusion time, wall following x 2):
   tau = C x the mean time between an agent's encounters.
 * ``mix`` -- the windows of K = 15 and 25 encounters per agent and the whole log, all
   in one vote; ``mix-K1-K2-...`` those of K1, K2, ..., and ``mix-K1-...-whole`` with
-  the whole log too.
+  the whole log too (each K at window scale 1; ``window_scales=S1,S2`` is the
+  pipeline's own form of ``mix-K1-K2``, K_i = S_i x ``window_encounters``).
 * ``witness`` -- lazy witness complex (nu = 1) on the landmarks with every event of the
   window as a witness, instead of Vietoris-Rips: edge (i, j) enters at
   min_w max(d(w, l_i), d(w, l_j)) - m_w, m_w the distance of w to its nearest landmark.
@@ -121,9 +122,9 @@ def _log_gaps(log, seed, factor):
 
 def _window_mix(log, seed, encounters=(15.0, 25.0), whole=True):
     """The windows of several K (encounters per agent), and the whole log, in one vote."""
-    runs = [_windows_of(log, seed, window_encounters=k) for k in encounters]
+    runs = [_windows_of(log, seed, window_encounters=k, window_scales=(1.0,)) for k in encounters]
     if whole:
-        runs.append(_windows_of(log, seed, window_length=WHOLE_LOG))
+        runs.append(_windows_of(log, seed, window_length=WHOLE_LOG, window_scales=(1.0,)))
     regions = [sum((list(r[i]) for r, _ in runs), []) for i in range(len(runs[0][0]))]
     return regions, runs[0][1]
 
@@ -303,10 +304,12 @@ def _trajectory(log, seed, factor):
 
 
 def _override(text):
-    """The variant ``FIELD=VALUE``: MapConfig(FIELD=VALUE), VALUE read as the field's default's type."""
+    """The variant ``FIELD=VALUE``: MapConfig(FIELD=VALUE), VALUE read as the field's default's type
+    (a tuple from comma-separated numbers: ``window_scales=0.75,1``)."""
     field, value = text.split("=", 1)
     default = getattr(MapConfig(), field)
-    value = value if isinstance(default, str) else type(default)(float(value)) if default is not None else float(value)
+    value = (value if isinstance(default, str) else tuple(float(x) for x in value.split(","))
+             if isinstance(default, tuple) else type(default)(float(value)) if default is not None else float(value))
     return lambda log, seed: _windows_of(log, seed, **{field: value})
 
 

@@ -37,32 +37,30 @@ from swarmtopo.pipeline import MapConfig
 
 ROOT = Path(__file__).resolve().parent.parent
 
-AUTO_WINDOWS = {"window_length": "auto", "window_encounters": 25.0, "window_step": "auto"}
+OURS = {"hop_cost": "auto", "diffusion_time": "auto", "wall_follow_weight": 2.0, "window_length": "auto",
+        "window_encounters": 20.0, "window_step": "auto"}
 CANDIDATES = {
-    **{f"h auto, diffusive, wall following x {c:g}, windows of 25 encounters per agent": {
-        "hop_cost": "auto", "diffusion_time": "auto", "wall_follow_weight": c, **AUTO_WINDOWS} for c in (1.5, 2.0)},
-    "h auto, diffusive, wall following x 2, windows of 20 encounters per agent": {
-        "hop_cost": "auto", "diffusion_time": "auto", "wall_follow_weight": 2.0, **AUTO_WINDOWS,
-        "window_encounters": 20.0},
-    "h auto, diffusive, windows of 25 encounters per agent (wall following diffusive too)": {
-        "hop_cost": "auto", "diffusion_time": "auto", "wall_follow_weight": "none", **AUTO_WINDOWS},
+    "h auto, diffusive, wall following x 2, windows of 20 encounters per agent": {**OURS, "window_scales": [1.0]},
+    "the same, windows of 15, 20 and 25 encounters per agent voting together": {
+        **OURS, "window_scales": [0.75, 1.0, 1.25]},
     "h 0, no diffusive weights, whole log (the paper's metric)": {
         "hop_cost": 0.0, "diffusion_time": "none", "wall_follow_weight": "none", "window_length": "none"},
 }
 """Candidate pipelines (hybrid metric, maxmin, automatic landmarks); "auto" h is
 r_d / v_c = 2 s for the simulated swarms; "diffusive" is the automatic diffusion time
 (``DIFFUSION_GAP_FACTOR`` x the mean time between an agent's encounters; the factor was
-chosen on tuning cases with ``benchmarks/levers.py``); "wall following x c" charges an
-agent's wall-following time c per second outside the diffusive weights
-(``MapConfig.wall_follow_weight``; 1.5 and 2 bracket the best of ``levers.py``'s
-``wall-C`` on tuning cases).  Windows of K encounters per
-agent are K times the mean time between an agent's encounters long
-(``MapConfig.window_encounters``).  Candidates measured in earlier rounds (fixed 20 s
-windows, the whole log with h, h = 0 with windows) are in docs/tuning.md's history."""
+chosen on tuning cases with ``benchmarks/levers.py``); "wall following x 2" charges an
+agent's wall-following time 2 s per second outside the diffusive weights
+(``MapConfig.wall_follow_weight``).  Windows of K encounters per agent are K times the
+mean time between an agent's encounters long (``MapConfig.window_encounters``); windows
+of several K vote together (``MapConfig.window_scales``: K = 20 x each scale).
+Candidates of earlier rounds (wall-following weights 1.5 and none, K = 25, fixed 20 s
+windows, the whole log with h, h = 0 with windows) are in docs/tuning.md's git history
+and in docs/accuracy.md."""
 
 
 CHOSEN_FIELDS = ("metric", "hop_cost", "diffusion_time", "wall_follow_weight", "window_length",
-                 "window_encounters", "window_step")
+                 "window_encounters", "window_scales", "window_step")
 """The MapConfig fields the candidates set: the winner's must be MapConfig's defaults."""
 
 

@@ -1,5 +1,6 @@
 """Accuracy benchmark: the frozen suite, the seed split, the table, and a regression slice."""
 
+import importlib.util
 import re
 from pathlib import Path
 
@@ -13,7 +14,8 @@ from swarmtopo.experiments import accuracy as acc
 from swarmtopo.experiments.grid import canonical_json
 from swarmtopo.experiments.sweep import run_job
 
-DOC = Path(__file__).resolve().parent.parent / "docs" / "accuracy.md"
+ROOT = Path(__file__).resolve().parent.parent
+DOC = ROOT / "docs" / "accuracy.md"
 FROZEN_DIGEST = "6e330f11fbcbae30"
 """Digest of the reporting cases (arena, swarm, salt, replicate, case seed) of suite swarmtopo-accuracy/1."""
 
@@ -117,3 +119,11 @@ def test_benchmark_runs_both_pipelines_on_dask_and_renders_its_table(tmp_path):
     assert "swarmtopo bench accuracy --test" in text and cells[0].name in text
     again = acc.run_benchmark(tmp_path / "acc.duckdb", per_cell=1, cells=cells, workers=1)
     assert again["jobs_run"] == 0 and again["records"] == summary["records"]  # resumed: nothing reruns
+    # benchmarks/reclassify.py reads the same default-pipeline maps back from the store's
+    # columns: under the shipped classifier they give the bench's own records
+    spec = importlib.util.spec_from_file_location("reclassify", ROOT / "benchmarks" / "reclassify.py")
+    reclassify = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(reclassify)
+    rows = reclassify.default_rows(str(tmp_path / "acc.duckdb"))
+    assert len(rows) == len(cells)
+    assert acc.outcomes(rows, load_classifier("default")) == summary["records"]

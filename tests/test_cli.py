@@ -202,6 +202,14 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     doc = json.loads((tmp_path / "a" / "map.json").read_text())
     assert doc["params"]["window_length"] is None and "encounters" in doc["params"]["window_source"]
     assert doc["params"]["wall_follow_weight"] == MapConfig.wall_follow_weight
+    assert doc["params"]["window_scales"] == list(MapConfig.window_scales)
+    scaled = run("map", simulated[0], "--out", tmp_path / "s", "-q", "--window-scales", "0.5,1")
+    assert scaled.returncode == 0, scaled.stderr
+    assert json.loads((tmp_path / "s" / "map.json").read_text())["params"]["window_scales"] == [0.5, 1.0]
+    assert_one_line_error(run("map", simulated[0], "--window-scales", "1,0"), "distinct positive numbers", code=2)
+    assert_one_line_error(run("map", simulated[0], "--window-scales", "1,x"), "comma-separated", code=2)
+    assert_one_line_error(run("map", simulated[0], "--paper", "--window-scales", "1,2"),
+                          "--paper fixes --window-scales", code=2)
     assert_one_line_error(run("map", simulated[0], "--paper", "--hop-cost", "1"), "--paper fixes --hop-cost", code=2)
     assert_one_line_error(run("map", simulated[0], "--paper", "--diffusion-time", "1"),
                           "--paper fixes --diffusion-time", code=2)

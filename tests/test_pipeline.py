@@ -9,7 +9,7 @@ from swarmtopo.arena import default_arena, square_arena, two_rooms_arena
 from swarmtopo.errors import SwarmtopoError
 from swarmtopo.log import EncounterLog
 from swarmtopo.pipeline import (DIFFUSION_GAP_FACTOR, HOP_GAP_FACTOR, WHOLE_LOG, MapConfig, _share_landmarks,
-                                _windows, map_encounters, mean_agent_gap, resolve_diffusion_time, resolve_hop_cost,
+                                _scaled_windows, _windows, map_encounters, mean_agent_gap, resolve_diffusion_time, resolve_hop_cost,
                                 resolve_window)
 from swarmtopo.sim import simulate
 
@@ -183,6 +183,38 @@ def test_windows_hand_computed():
     # step 12: 1 + ceil(18 / 12) = 3 windows, starts 0, 9, 18
     assert _windows(t, 12.0, 12.0) == [(0.0, 12.0), (9.0, 21.0), (18.0, 30.0)]
     assert _windows(t, 30.0) == [None] and _windows(t, WHOLE_LOG) == [None]
+
+
+def test_scaled_windows_are_the_distinct_windows_of_every_length():
+    t = np.array([0.0, 7.0, 30.0])
+    # 20 s: [0, 20], [10, 30]; 15 s (step 7.5): [0, 15], [7.5, 22.5], [15, 30]; 30 s: the whole log
+    assert _scaled_windows(t, [20.0, 15.0, 30.0]) == [(0.0, 20.0), (10.0, 30.0), (0.0, 15.0), (7.5, 22.5),
+                                                       (15.0, 30.0), None]
+    assert _scaled_windows(t, [20.0, 20.0]) == _windows(t, 20.0)  # a window is voted once
+    assert _scaled_windows(t, [30.0, WHOLE_LOG]) == [None]
+
+
+def test_window_scales_vote_over_the_windows_of_every_scale():
+    log = simulate(default_arena(), 150, 30.0, rng=2).log
+    base = dict(window_encounters=8.0, **FAST)
+    mixed = map_encounters(log, MapConfig(window_scales=(0.75, 1.0, 1.5), **base))
+    single = [map_encounters(log, MapConfig(window_scales=(1.0,), **{**base, "window_encounters": 8.0 * s}))
+              for s in (0.75, 1.0, 1.5)]
+    spans = [(w.t0, w.t1) for w in mixed.regions[0].windows]
+    assert spans == [(w.t0, w.t1) for m in single for w in m.regions[0].windows]  # every scale's windows, once
+    assert len({round(t1 - t0, 9) for t0, t1 in spans}) == 3
+    counts = sorted(w.betti[1] for w in mixed.regions[0].windows)
+    assert mixed.betti[1] == counts[(len(counts) - 1) // 2]  # one lower-median vote over them all
+    assert mixed.window_length == single[1].window_length  # the scale-1 length is the one reported
+    assert mixed.to_json()["params"]["window_scales"] == [0.75, 1.0, 1.5]
+
+
+@pytest.mark.parametrize("scales, message", [((), "one or more positive"), ((1.0, 0.0), "one or more positive"),
+                                             ((1.0, float("nan")), "one or more positive"),
+                                             ((1.0, 1.0), "distinct")])
+def test_bad_window_scales_are_refused(scales, message):
+    with pytest.raises(SwarmtopoError, match=message):
+        MapConfig(window_scales=scales).validate()
 
 
 def test_hop_cost_comes_from_meta_then_from_the_data():

@@ -24,6 +24,7 @@ from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.experiments.grid import expand_grid, read_sweep
 from swarmtopo.experiments.store import RUN_COLUMNS, ResultStore, read_jobs
 from swarmtopo.experiments.sweep import job_map_config, run_job, run_sweep
+from swarmtopo.pipeline import MapConfig
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "sweep-small.toml"
 
@@ -87,7 +88,7 @@ def test_grid_is_the_product_of_lists_times_replicates_with_defaults():
                   "outer": "square", "scale": 1.0},
         "swarm": {"agents": job.config["swarm"]["agents"], "duration": 20.0, "static_fraction": 0.0},
         "map": {"metric": "hybrid", "hop_cost": "auto", "diffusion_time": "auto", "wall_follow_weight": 2.0,
-                "window_length": "auto", "window_encounters": 20.0,
+                "window_length": "auto", "window_encounters": 20.0, "window_scales": list(MapConfig.window_scales),
                 "window_step": "auto", "subsample": "maxmin", "landmarks": "auto", "max_landmarks": 400, "maxdim": 1, "classifier": "default"},
     }
     # max_landmarks only caps "auto": a fixed L drops it
@@ -105,6 +106,20 @@ def test_job_map_config_reads_words_and_numbers():
     default = job_map_config(expand_grid({"map": {"wall_follow_weight": 1.5}}).jobs[0].config["map"])
     assert (default.hop_cost, default.diffusion_time, default.wall_follow_weight, default.window_length) == \
         (None, None, 1.5, None)
+    assert default.window_scales == MapConfig.window_scales and config.window_scales == MapConfig.window_scales
+    scaled = job_map_config(expand_grid({"map": {"window_scales": [1.25, 0.75, 1]}}).jobs[0].config["map"])
+    assert scaled.window_scales == (0.75, 1.0, 1.25)
+
+
+def test_window_scales_flat_list_is_one_set_and_list_of_lists_a_grid():
+    one = expand_grid({"map": {"window_scales": [1.25, 1, 0.75, 1]}})
+    assert [j.config["map"]["window_scales"] for j in one.jobs] == [[0.75, 1.0, 1.25]]  # canonical: sorted, distinct
+    assert one.jobs[0].key == expand_grid({"map": {"window_scales": [0.75, 1.25, 1.0]}}).jobs[0].key
+    grid = expand_grid({"map": {"window_scales": [[1], [0.75, 1]]}})
+    assert [j.config["map"]["window_scales"] for j in grid.jobs] == [[1.0], [0.75, 1.0]]
+    assert expand_grid({"map": {"window_scales": 1.5}}).jobs[0].config["map"]["window_scales"] == [1.5]
+    whole = expand_grid({"map": {"window_length": "none"}}).jobs[0].config["map"]
+    assert "window_scales" not in whole  # one window: no scales to vote
 
 
 def test_shapes_flat_list_is_one_set_and_list_of_lists_a_grid():
@@ -180,6 +195,9 @@ def test_keys_are_the_same_in_another_process():
     ("[map]\nwindow_length = 20\nwindow_encounters = 30", ["[map] window_encounters", 'window_length is not "auto"']),
     ("[map]\nwindow_encounters = 0", ["[map] window_encounters = 0", "> 0"]),
     ("[map]\nwindow_length = 'none'\nwindow_step = 5", ["[map] window_step", 'window_length is "none"']),
+    ("[map]\nwindow_length = 'none'\nwindow_scales = [1, 2]", ["[map] window_scales", 'window_length is "none"']),
+    ("[map]\nwindow_scales = [1, 0]", ["[map] window_scales = [1, 0]", "positive number"]),
+    ("[map]\nwindow_scales = []", ["[map] window_scales = []", "positive number"]),
     ("[map]\nclassifier = 'nope.json'", ['[map] classifier = "nope.json"', "cannot read"]),
     ("[arena]\nholes = []", ["[arena] holes = []", "empty list"]),
     ("[arena]\nshapes = ['hexagon']", ['[arena] shapes = ["hexagon"]', "square"]),
@@ -209,7 +227,7 @@ def test_cli_bad_config_is_one_line_exit_1(tmp_path):
     assert proc.returncode == 1 and "Traceback" not in proc.stderr
     assert proc.stderr.strip().splitlines() == [f"error: {path}: [map] metrc: unknown key; expected one of "
                                                 "metric, hop_cost, diffusion_time, wall_follow_weight, window_length, "
-                                                "window_encounters, "
+                                                "window_encounters, window_scales, "
                                                 "window_step, "
                                                 "subsample, landmarks, "
                                                 "max_landmarks, maxdim, classifier"]

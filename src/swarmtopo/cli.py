@@ -195,6 +195,19 @@ def _parse_seconds(text: Optional[str]):
     return text
 
 
+def _parse_scales(text: Optional[str]):
+    """A --window-scales value: comma-separated distinct positive numbers."""
+    if text is None:
+        return None
+    try:
+        scales = tuple(float(x) for x in text.split(","))
+    except ValueError:
+        raise typer.BadParameter(f"{text!r} is not a comma-separated list of numbers (e.g. 0.75,1,1.25)") from None
+    if not all(math.isfinite(x) and x > 0 for x in scales) or len(set(scales)) < len(scales):
+        raise typer.BadParameter(f"{text!r}: the scales must be distinct positive numbers")
+    return scales
+
+
 @app.command("map", epilog="Example: swarmtopo map runs/two-holes --out runs/two-holes/map --metric hybrid --landmarks 300")
 def map_command(
     log_dir: Path = typer.Argument(..., help="Log folder: events.csv|parquet, optional status, meta.json."),
@@ -227,6 +240,10 @@ def map_command(
         None, "--window-length", callback=_parse_seconds,
         help="Seconds of the time windows whose maps vote; 'none' maps the whole log at once; 'auto' (default) "
              "holds about 20 encounters per agent (20 x the mean time between an agent's encounters)."),
+    window_scales: Optional[str] = typer.Option(
+        None, "--window-scales", callback=_parse_scales,
+        help="Comma-separated multipliers of the window length: the windows of every such length vote together "
+             "(default: 1, a single window length; 0.75,1,1.25 was measured and not adopted: docs/accuracy.md)."),
     classifier: Optional[str] = typer.Option(
         None, "--classifier",
         help="Betti classifier: default (tuned on the accuracy benchmark), paper-form (the paper's form trained "
@@ -247,18 +264,21 @@ def map_command(
     if paper:
         given = [name for name, value in (("--hop-cost", hop_cost), ("--diffusion-time", diffusion_time),
                                           ("--wall-follow-weight", wall_follow_weight),
-                                          ("--window-length", window_length), ("--classifier", classifier))
+                                          ("--window-length", window_length), ("--window-scales", window_scales),
+                                          ("--classifier", classifier))
                  if value is not None]
         if given:
             raise typer.BadParameter(f"--paper fixes {', '.join(given)}; drop one or the other")
         hop_cost, diffusion_time, wall_follow_weight, window_length, classifier = 0.0, "none", "none", "none", "paper"
+        window_scales = (1.0,)
     out_dir = out_dir or log_dir / "map"
     model = load_classifier(classifier or "default")
     log = read_log(log_dir)
     config = MapConfig(metric=metric, subsample=subsample, landmarks=landmarks, window=window, maxdim=maxdim,
                        seed=seed, hop_cost=hop_cost, diffusion_time=seconds_option(diffusion_time),
                        wall_follow_weight=wall_follow_option(wall_follow_weight),
-                       window_length=seconds_option(window_length))
+                       window_length=seconds_option(window_length),
+                       window_scales=window_scales or MapConfig.window_scales)
     if verbose:
         _detail(f"log {log_dir}: {log.n_events} encounters of {log.n_agents} agents over {log.duration:g} s")
     tmap, written = _run_map(log, config, log_dir, out_dir, quiet, verbose, classifier=model)
@@ -534,7 +554,8 @@ def _map_details(tmap) -> None:
                 f"threshold {', '.join(f'{v:.3g} s' for v in r.thresholds.values())}; "
                 f"{len(r.cycles)} loop(s) found")
         if len(r.windows) > 1:
-            _detail(f"region {r.component}: {len(r.windows)} windows of {tmap.window_length[0]:.3g} s counted "
+            scales = ", ".join(f"{x:g}" for x in tmap.config.window_scales)
+            _detail(f"region {r.component}: {len(r.windows)} windows of {scales} x {tmap.window_length[0]:.3g} s counted "
                     f"{[w.betti.get(1) for w in r.windows]} holes; vote {r.betti.get(1)}, shown: window "
                     f"{r.window} [{r.windows[r.window].t0:.1f}, {r.windows[r.window].t1:.1f}] s")
     _detail(f"per-hop cost h = {tmap.hop_cost[0]:.3g} s ({tmap.hop_cost[1]}); diffusion time "

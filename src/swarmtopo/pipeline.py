@@ -58,6 +58,9 @@ consecutive encounters (docs/tuning.md)."""
 WALL_FOLLOW_WEIGHT = 2.0
 """Default ``MapConfig.wall_follow_weight``: seconds charged per second of wall following
 inside a chain gap, outside the diffusive compression (docs/tuning.md)."""
+WINDOW_SCALES = (1.0,)
+"""Default ``MapConfig.window_scales``: multipliers of the window length whose windows
+all vote; one length (docs/tuning.md)."""
 WHOLE_LOG = float("inf")
 """``MapConfig.window_length`` that maps the whole log at once (the paper)."""
 
@@ -121,6 +124,13 @@ class MapConfig:
     window_encounters
         K, the encounters per agent an automatic window holds (default 20, chosen on
         the benchmark's tuning cases: docs/tuning.md).
+    window_scales
+        Multipliers s of the window length: the windows of every length s x W (s x K
+        encounters per agent when automatic; each its own ``window_step``, default half
+        its length) vote together, each distinct window once.  A scale whose windows
+        would not be shorter than the log maps the whole log.  Default
+        ``WINDOW_SCALES``, one length: (0.75, 1, 1.25) was no better on the tuning
+        cases at three times the time (docs/tuning.md).
     window_step
         Seconds between the starts of consecutive windows; None (default) = half the
         window length, so windows overlap by half and a log of T seconds gets
@@ -164,6 +174,7 @@ class MapConfig:
     wall_follow_weight: float | None = WALL_FOLLOW_WEIGHT
     window_length: float | None = None
     window_encounters: float = 20.0
+    window_scales: tuple[float, ...] = WINDOW_SCALES
     window_step: float | None = None
     subsample: str = "maxmin"
     landmarks: int | None = None
@@ -177,6 +188,11 @@ class MapConfig:
     min_region_events: int = 50
     embed_dim: int = 3
     cycles: bool = True
+
+    def __post_init__(self):
+        scales = self.window_scales
+        object.__setattr__(self, "window_scales",
+                           tuple(scales) if isinstance(scales, (list, tuple, np.ndarray)) else (scales,))
 
     def validate(self) -> "MapConfig":
         if self.metric not in METRICS:
@@ -200,6 +216,12 @@ class MapConfig:
             raise SwarmtopoError(f"window_length must be a positive number of seconds, got {self.window_length}")
         if not (np.isfinite(self.window_encounters) and self.window_encounters > 0):
             raise SwarmtopoError(f"window_encounters must be a positive number, got {self.window_encounters}")
+        scales = self.window_scales
+        if not scales or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) and x > 0
+                                 for x in scales):
+            raise SwarmtopoError(f"window_scales must be one or more positive numbers, got {list(scales)}")
+        if len(set(scales)) < len(scales):
+            raise SwarmtopoError(f"window_scales must be distinct, got {list(scales)}")
         if self.window_step is not None and not (np.isfinite(self.window_step) and self.window_step > 0):
             raise SwarmtopoError(f"window_step must be a positive number of seconds, got {self.window_step}")
         if self.maxdim not in (1, 2):
@@ -417,14 +439,19 @@ def map_encounters(
 
     shares = (_share_landmarks(config.landmarks, events_per_comp[regions_idx]) if config.landmarks
               else [None] * len(regions_idx))
-    window_length, window_source = resolve_window(agent_gap, config.window_length, config.window_encounters,
-                                                  float(graph.event_t.max() - graph.event_t.min()))
-    spans = _windows(graph.event_t, window_length, config.window_step)
+    log_span = float(graph.event_t.max() - graph.event_t.min())
+    window_length, window_source = resolve_window(agent_gap, config.window_length, config.window_encounters, log_span)
+    spans = _scaled_windows(graph.event_t, [
+        resolve_window(agent_gap, None if config.window_length is None else scale * config.window_length,
+                       scale * config.window_encounters, log_span)[0] for scale in config.window_scales],
+        config.window_step)
     window_graphs = [(None, graph, labels)]  # (span, graph, component labels) of each window
     if len(spans) > 1:
         window_graphs = []
         for span in spans:
-            if _events_within(log, span) >= config.min_region_events:  # a gap in a real trace is skipped
+            if span is None:  # a scale whose windows would not be shorter than the log
+                window_graphs.append((None, graph, labels))
+            elif _events_within(log, span) >= config.min_region_events:  # a gap in a real trace is skipped
                 wgraph = build_graph(log, config.metric, window=span, hop_cost=hop_cost,
                                      diffusion_time=diffusion_time, wall_follow_weight=config.wall_follow_weight)
                 window_graphs.append((span, wgraph, wgraph.components()[1]))
@@ -592,6 +619,12 @@ def _windows(event_t: np.ndarray, length: float, step: float | None = None) -> l
     step = length / 2 if step is None else step
     n = 1 + int(np.ceil((t_last - t_first - length) / step - 1e-9))
     return [(float(s), float(s) + length) for s in np.linspace(t_first, t_last - length, n)]
+
+
+def _scaled_windows(event_t: np.ndarray, lengths, step: float | None = None) -> list[tuple[float, float] | None]:
+    """The distinct windows of every length in ``lengths`` (:func:`_windows`), in order:
+    by length as given, then by start."""
+    return list(dict.fromkeys(span for length in lengths for span in _windows(event_t, length, step)))
 
 
 def _events_within(log: EncounterLog, span: tuple[float, float]) -> int:

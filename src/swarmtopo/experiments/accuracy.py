@@ -57,12 +57,13 @@ QUICK_PER_CELL = 10
 SLICE_PER_CELL = 2
 """The regression slice: the first SLICE_PER_CELL reporting cases of every cell
 (default pipeline), rerun by tests/test_accuracy.py against the rate recorded here."""
-TUNING_PER_CELL = 12
+TUNING_PER_CELL = 24
 
 PIPELINES: dict[str, dict[str, Any]] = {
     "default": {"metric": "hybrid", "hop_cost": "auto", "diffusion_time": "auto",
                 "wall_follow_weight": MapConfig.wall_follow_weight, "window_length": "auto",
-                "window_encounters": MapConfig.window_encounters, "window_step": "auto", "classifier": "default"},
+                "window_encounters": MapConfig.window_encounters, "window_scales": list(MapConfig.window_scales),
+                "window_step": "auto", "classifier": "default"},
     "paper": {"metric": "hybrid", "hop_cost": 0.0, "diffusion_time": "none", "wall_follow_weight": "none",
               "window_length": "none", "classifier": "paper-form"},
 }

@@ -33,10 +33,11 @@ Format (``examples/sweep-small.toml`` is a commented example)::
     window_length = "auto"    # windows voted over, s: a number > 0, "auto" (default: window_encounters
                               # encounters per agent) or "none" (whole log, the paper)
     window_encounters = 20.0  # K of automatic windows (only with window_length = "auto")
+    window_scales = [1.0]     # multipliers of the window length whose windows all vote (default [1])
     window_step = "auto"      # s between window starts: a number > 0 or "auto" (half the length)
     subsample = "maxmin"      # maxmin | knn | probabilistic (default maxmin)
     landmarks = "auto"        # an integer L >= 3, or "auto" (default)
-    max_landmarks = 1000      # cap of the automatic count (only with landmarks = "auto")
+    max_landmarks = 400       # cap of the automatic count (only with landmarks = "auto")
     maxdim = 1                # highest homology dimension, 1 or 2 (default 1)
     classifier = "default"    # "default", "paper", or a classifier JSON file
 
@@ -46,6 +47,8 @@ set of hole families, each hole drawing its family uniformly from the set: a str
 or a list of strings is one set (``["square", "disc"]``: every arena mixes squares and
 discs); a list of lists is a grid over sets (``[["square"], ["square", "disc"]]``: two
 grid points).  A set is canonical sorted, so ``["disc", "square"]`` is the same job.
+``window_scales`` is a set the same way: ``[0.75, 1, 1.25]`` is one set of three
+scales, ``[[1], [0.75, 1, 1.25]]`` two grid points.
 
 Canonical configuration.  Each grid point becomes a nested dict ``{"arena": ...,
 "swarm": ..., "map": ...}`` with defaults filled in and only the keys its generator
@@ -144,6 +147,18 @@ def _shape_set(value) -> tuple[str, ...]:
     return tuple(sorted(set(shapes)))
 
 
+def _scale_set(value) -> tuple[float, ...]:
+    scales = value if isinstance(value, list) else [value]
+    number = _number(0.0, strict=True)
+    try:
+        checked = [number(v) for v in scales]
+    except _Bad:
+        raise _Bad("expected a positive number or a list of them") from None
+    if not checked:
+        raise _Bad("expected a positive number or a list of them")
+    return tuple(sorted(set(checked)))
+
+
 def _or_word(words: str | tuple[str, ...], check: Callable[[Any], float]) -> Callable[[Any], Any]:
     """A number passing ``check``, or one of the strings ``words`` ("auto", "none")."""
     words = (words,) if isinstance(words, str) else words
@@ -197,6 +212,7 @@ PARAMS: tuple[Param, ...] = (
           "DOUBLE"),
     Param("map", "window_length", "auto", _or_word(("auto", "none"), _number(0.0, strict=True)), "DOUBLE"),
     Param("map", "window_encounters", MapConfig().window_encounters, _number(0.0, strict=True), "DOUBLE"),
+    Param("map", "window_scales", tuple(sorted(MapConfig().window_scales)), _scale_set, "DOUBLE[]"),
     Param("map", "window_step", "auto", _or_word("auto", _number(0.0, strict=True)), "DOUBLE"),
     Param("map", "subsample", "maxmin", _choice(tuple(SUBSAMPLERS)), "TEXT"),
     Param("map", "landmarks", "auto", _landmarks, "INTEGER"),
@@ -413,7 +429,7 @@ def _axis(table: dict, param: Param, fail) -> list[Any]:
     if param.name not in table:
         return [param.default]
     raw = table[param.name]
-    if param.name == "shapes":  # a string or list of strings is one set; a list of lists, a grid
+    if param.name in ("shapes", "window_scales"):  # a value or list of values is one set; a list of lists, a grid
         values = raw if isinstance(raw, list) and raw and all(isinstance(v, list) for v in raw) else [raw]
     else:
         values = raw if isinstance(raw, list) else [raw]
@@ -480,6 +496,8 @@ def _canonical(point: dict, inputs: _InputFiles, fail):
         mapping["window_step"] = point[("map", "window_step")]
     if mapping["window_length"] == "auto":
         mapping["window_encounters"] = point[("map", "window_encounters")]
+    if mapping["window_length"] != "none":
+        mapping["window_scales"] = list(point[("map", "window_scales")])
     if mapping["landmarks"] == "auto":
         mapping["max_landmarks"] = point[("map", "max_landmarks")]
     if mapping["classifier"] not in PRESETS:
@@ -501,7 +519,7 @@ def _unused_reason(table: str, key: str, document: dict) -> str:
                 f"(only by {', '.join(repr(g) for g in users)})")
     if key == "static_time":
         return "not used: static_fraction is 0 (no agent stops for good)"
-    if key == "window_step":
+    if key in ("window_step", "window_scales"):
         return 'not used: window_length is "none" (the whole log at once)'
     if key == "window_encounters":
         return 'not used: window_length is not "auto" (a length in seconds, or "none")'

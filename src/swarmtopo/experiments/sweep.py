@@ -105,6 +105,7 @@ def job_map_config(mapping: dict[str, Any], seed: int | None = None) -> MapConfi
         wall_follow_weight=wall_follow_option(mapping["wall_follow_weight"]),
         window_length=seconds_option(mapping["window_length"]),
         window_encounters=mapping.get("window_encounters", MapConfig.window_encounters),
+        window_scales=tuple(mapping.get("window_scales", MapConfig.window_scales)),
         window_step=seconds_option(mapping.get("window_step")),
         landmarks=None if mapping["landmarks"] == "auto" else mapping["landmarks"],
         max_landmarks=mapping.get("max_landmarks", MapConfig.max_landmarks),
