@@ -15,7 +15,10 @@ diffusion time, wall following x 2):
 * ``20s`` -- fixed 20 s windows overlapping by half (the previous default).
 * ``whole`` -- the whole log at once.
 * ``quarter`` -- automatic windows started every quarter window (twice the windows).
-* ``draws`` -- three landmark draws (seeds) per window, all their counts voted.
+* ``draws`` -- three landmark draws (seeds) per window, all their counts voted;
+  ``draws-K`` K draws.  The map's seed is the case's; draw d uses seed + d.
+* ``seed+D`` -- the default with the landmark draw of seed + D: one of ``draws-K``'s
+  draws on its own (``default`` is draw 0), to measure the spread a draw causes.
 * ``switch`` -- a cost per change of agent instead of per hop: every pair of one
   agent's events joined with D_tau(its chain time) + h (the paper's all-pairs graph plus
   h: a path pays h once per agent it rides), built literally, O(m^2) per agent; wall
@@ -316,6 +319,10 @@ def _override(text):
 def _variant(name):
     if "=" in name:
         return _override(name)
+    if name.startswith("draws-"):
+        return lambda log, seed: _draws(log, seed, int(name.split("-", 1)[1]))
+    if name.startswith("seed+"):
+        return lambda log, seed: _windows_of(log, seed + int(name.split("+", 1)[1]))
     if name.startswith("wall-"):
         return lambda log, seed: _windows_of(log, seed, wall_follow_weight=P.wall_follow_option(name.split("-", 1)[1]))
     if name.startswith("smooth-"):
@@ -394,7 +401,7 @@ def main() -> None:
     parser.add_argument("--per-cell", type=int, default=12)
     parser.add_argument("--variants", nargs="+", default=["default", "20s", "whole", "quarter", "draws", "switch"],
                         help=f"{', '.join(sorted(VARIANTS))}, diffusive-C, switch-C, log-C, wall-C, wall-none, "
-                             "smooth-HOW-K, paths-C, dtm-K, mds-D, mix-K1-K2[-whole] or FIELD=VALUE")
+                             "smooth-HOW-K, paths-C, dtm-K, mds-D, mix-K1-K2[-whole], draws-K, seed+D or FIELD=VALUE")
     parser.add_argument("--cells", nargs="+", metavar="TEXT",
                         help="only the cells whose name contains one of these (default: all)")
     parser.add_argument("--processes", type=int, default=2)
