@@ -309,10 +309,14 @@ def _trajectory(log, seed, factor):
 def _override(text):
     """The variant ``FIELD=VALUE``: MapConfig(FIELD=VALUE), VALUE read as the field's default's type
     (a tuple from comma-separated numbers: ``window_scales=0.75,1``)."""
-    field, value = text.split("=", 1)
+    field, text = text.split("=", 1)
     default = getattr(MapConfig(), field)
-    value = (value if isinstance(default, str) else tuple(float(x) for x in value.split(","))
-             if isinstance(default, tuple) else type(default)(float(value)) if default is not None else float(value))
+    if isinstance(default, str):
+        value = text
+    elif isinstance(default, tuple):
+        value = tuple(float(x) for x in text.split(","))
+    else:
+        value = float(text) if default is None else type(default)(float(text))
     return lambda log, seed: _windows_of(log, seed, **{field: value})
 
 

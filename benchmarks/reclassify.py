@@ -3,7 +3,10 @@
 ``swarmtopo bench accuracy`` stores every default-pipeline map's per-window diagrams, so
 the same maps can be read again by another classifier without mapping anything.  For
 each classifier given, prints exact (beta_0, beta_1) over the reporting maps, per cell
-and for the held-out family, with the Brier score of its beta_1 confidence.  Reading a
+and for the held-out family, with the Brier score of its beta_1 confidence; then per
+budget (the two rooms on their own) the wrong maps counting too many and too few holes
+and the held-out family's exact maps, and the range of the wrong maps' beta_1
+confidence.  Reading a
 store made by an older swarmtopo (other grid columns) works too: only the columns the
 verdict needs are read, so two rounds' maps can be compared under one classifier.
 
@@ -18,31 +21,19 @@ Example: the previous round's classifier on this round's maps:
 from __future__ import annotations
 
 import argparse
-import json
-
-import duckdb
 
 from swarmtopo.classify import load_classifier
 from swarmtopo.experiments.accuracy import CELLS, PIPELINES, accuracy_table, outcomes, reliability
+from swarmtopo.experiments.store import read_jobs
 
 COLUMNS = ("key", "config", "replicate", "diagrams", "error", "est_betti0", "true_betti0", "true_betti1", "t_total")
+"""The columns the verdict needs (``accuracy.outcomes``)."""
 
 
 def default_rows(store: str) -> list[dict]:
     """The store's rows of the default pipeline (its ``classifier`` is "default"), sorted by key."""
-    db = duckdb.connect(store, read_only=True)
-    try:
-        rows = db.execute(f"SELECT {', '.join(COLUMNS)} FROM jobs ORDER BY key").fetchall()
-    finally:
-        db.close()
-    parsed = []
-    for values in rows:
-        row = dict(zip(COLUMNS, values))
-        row["config"] = json.loads(row["config"])
-        row["diagrams"] = json.loads(row["diagrams"]) if row["diagrams"] else None
-        if row["config"]["map"].get("classifier") == PIPELINES["default"]["classifier"]:
-            parsed.append(row)
-    return parsed
+    return [row for row in read_jobs(store, columns=COLUMNS)
+            if row["config"]["map"].get("classifier") == PIPELINES["default"]["classifier"]]
 
 
 def main() -> None:
@@ -60,6 +51,32 @@ def main() -> None:
         print(f"{name}: {table['overall'].right}/{table['overall'].total} exact; per cell [{cells}]; "
               f"held-out family {table['held_out'].right}/{table['held_out'].total}; "
               f"Brier {rel['brier']:.4f} (constant {rel['brier_constant']:.4f})")
+        print("  " + _misses(records))
+
+
+def _group(record: dict) -> str:
+    """A record's budget ("200 x 30 s"), or "two rooms"."""
+    cell = record["cell"]
+    return "two rooms" if cell.startswith("two rooms") else cell.split(", ", 1)[1]
+
+
+def _misses(records: list[dict]) -> str:
+    """Per group: wrong maps with beta_1 too high / too low, held-out family right / all;
+    then the wrong maps' beta_1 confidence range."""
+    parts = []
+    for group in dict.fromkeys(_group({"cell": cell.name}) for cell in CELLS):
+        mine = [r for r in records if _group(r) == group]
+        wrong = [r for r in mine if not r["right"] and r["est_betti1"] is not None]
+        held = [r for r in mine if r["held_out"]]
+        parts.append(f"{group}: {sum(r['est_betti1'] > r['true_betti1'] for r in wrong)} too many / "
+                     f"{sum(r['est_betti1'] < r['true_betti1'] for r in wrong)} too few holes, held-out "
+                     f"{sum(r['right'] for r in held)}/{len(held)}")
+    confidences = sorted(r["confidence_betti1"] for r in records
+                         if not r["right"] and r["confidence_betti1"] is not None)
+    if confidences:
+        parts.append(f"wrong maps' beta_1 confidence {confidences[0]:.2f}-{confidences[-1]:.2f}, "
+                     f"{sum(c >= 0.8 for c in confidences)} of {len(confidences)} at 0.8 or more")
+    return "; ".join(parts)
 
 
 if __name__ == "__main__":

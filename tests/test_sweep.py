@@ -317,6 +317,13 @@ def test_foreign_files_are_refused_as_stores(tmp_path):
     for open_store in (ResultStore, read_jobs):
         with pytest.raises(SwarmtopoError, match="missing columns: sweep, replicate.*unknown: answer"):
             open_store(tmp_path / "other.duckdb")
+    # a store of another version is read for the columns asked, if it has them
+    with duckdb.connect(str(tmp_path / "other.duckdb")) as db:
+        db.execute("INSERT INTO jobs VALUES ('k2', 2), ('k1', 1)")
+    assert read_jobs(tmp_path / "other.duckdb", columns=("key", "answer")) == [{"key": "k1", "answer": 1},
+                                                                              {"key": "k2", "answer": 2}]
+    with pytest.raises(SwarmtopoError, match="lacks the columns config"):
+        read_jobs(tmp_path / "other.duckdb", columns=("key", "config"))
 
 
 # -- sweeps on real clusters -----------------------------------------------------------

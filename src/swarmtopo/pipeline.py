@@ -445,16 +445,14 @@ def map_encounters(
         resolve_window(agent_gap, None if config.window_length is None else scale * config.window_length,
                        scale * config.window_encounters, log_span)[0] for scale in config.window_scales],
         config.window_step)
-    window_graphs = [(None, graph, labels)]  # (span, graph, component labels) of each window
-    if len(spans) > 1:
-        window_graphs = []
-        for span in spans:
-            if span is None:  # a scale whose windows would not be shorter than the log
-                window_graphs.append((None, graph, labels))
-            elif _events_within(log, span) >= config.min_region_events:  # a gap in a real trace is skipped
-                wgraph = build_graph(log, config.metric, window=span, hop_cost=hop_cost,
-                                     diffusion_time=diffusion_time, wall_follow_weight=config.wall_follow_weight)
-                window_graphs.append((span, wgraph, wgraph.components()[1]))
+    window_graphs = []  # (span, graph, component labels) of each window
+    for span in spans:
+        if span is None:  # the whole log: a scale whose windows would not be shorter than it
+            window_graphs.append((None, graph, labels))
+        elif _events_within(log, span) >= config.min_region_events:  # a gap in a real trace is skipped
+            wgraph = build_graph(log, config.metric, window=span, hop_cost=hop_cost,
+                                 diffusion_time=diffusion_time, wall_follow_weight=config.wall_follow_weight)
+            window_graphs.append((span, wgraph, wgraph.components()[1]))
     regions: list[RegionMap] = []
     for comp, n_land in zip(regions_idx, shares):
         region_events = graph.event_index[event_comp == comp]

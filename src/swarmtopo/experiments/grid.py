@@ -183,19 +183,21 @@ def _landmarks(value):
 
 @dataclass(frozen=True)
 class Param:
-    """One grid key: its table, default, check, and SQL type of its store column."""
+    """One grid key: its table, default, check, SQL type of its store column, and whether
+    its value is a set (a value or a flat list is one set; a list of lists, a grid)."""
 
     table: str
     name: str
     default: Any
     check: Callable[[Any], Any]
     sql: str
+    set_valued: bool = False
 
 
 PARAMS: tuple[Param, ...] = (
     Param("arena", "generator", "random", _choice(tuple(GENERATORS)), "TEXT"),
     Param("arena", "holes", 1, _integer(0), "INTEGER"),
-    Param("arena", "shapes", ("square",), _shape_set, "TEXT[]"),
+    Param("arena", "shapes", ("square",), _shape_set, "TEXT[]", set_valued=True),
     Param("arena", "outer", "square", _choice(OUTER_SHAPES), "TEXT"),
     Param("arena", "scale", 1.0, _number(0.0, strict=True), "DOUBLE"),
     Param("arena", "r_outer", 250.0, _number(0.0, strict=True), "DOUBLE"),
@@ -212,7 +214,8 @@ PARAMS: tuple[Param, ...] = (
           "DOUBLE"),
     Param("map", "window_length", "auto", _or_word(("auto", "none"), _number(0.0, strict=True)), "DOUBLE"),
     Param("map", "window_encounters", MapConfig().window_encounters, _number(0.0, strict=True), "DOUBLE"),
-    Param("map", "window_scales", tuple(sorted(MapConfig().window_scales)), _scale_set, "DOUBLE[]"),
+    Param("map", "window_scales", tuple(sorted(MapConfig().window_scales)), _scale_set, "DOUBLE[]",
+          set_valued=True),
     Param("map", "window_step", "auto", _or_word("auto", _number(0.0, strict=True)), "DOUBLE"),
     Param("map", "subsample", "maxmin", _choice(tuple(SUBSAMPLERS)), "TEXT"),
     Param("map", "landmarks", "auto", _landmarks, "INTEGER"),
@@ -429,7 +432,7 @@ def _axis(table: dict, param: Param, fail) -> list[Any]:
     if param.name not in table:
         return [param.default]
     raw = table[param.name]
-    if param.name in ("shapes", "window_scales"):  # a value or list of values is one set; a list of lists, a grid
+    if param.set_valued:  # a value or list of values is one set; a list of lists, a grid
         values = raw if isinstance(raw, list) and raw and all(isinstance(v, list) for v in raw) else [raw]
     else:
         values = raw if isinstance(raw, list) else [raw]

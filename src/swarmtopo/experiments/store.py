@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any, Iterable
+from typing import Any, Iterable, Sequence
 
 from ..errors import SwarmtopoError
 from .grid import PARAMS
@@ -129,7 +129,7 @@ class ResultStore:
         return self._db.execute(self._insert, values).fetchone()[0] == 1
 
 
-def read_jobs(path, sweep: str | None = None) -> list[dict[str, Any]]:
+def read_jobs(path, sweep: str | None = None, columns: Sequence[str] | None = None) -> list[dict[str, Any]]:
     """Rows of a result store as dicts, sorted by key.
 
     Parameters
@@ -138,6 +138,9 @@ def read_jobs(path, sweep: str | None = None) -> list[dict[str, Any]]:
         The DuckDB file.
     sweep
         Only the finished jobs of this sweep (``[sweep] name``); None = every row.
+    columns
+        Only these columns (``key`` among them); a store written by another swarmtopo
+        version is read too if it has them.  None = every column of this version's store.
 
     Returns
     -------
@@ -156,11 +159,12 @@ def read_jobs(path, sweep: str | None = None) -> list[dict[str, Any]]:
     except duckdb.Error as exc:
         raise SwarmtopoError(f"{path}: cannot open the result store ({_first_line(exc)})") from None
     try:
-        _check_schema(db, path)
+        _check_schema(db, path, columns)
+        selected = "jobs.*" if columns is None else ", ".join(f"jobs.{name}" for name in columns)
         if sweep is None:
-            cursor = db.execute("SELECT * FROM jobs ORDER BY key")
+            cursor = db.execute(f"SELECT {selected} FROM jobs ORDER BY key")
         else:
-            cursor = db.execute("SELECT jobs.* FROM jobs JOIN sweep_jobs USING (key) "
+            cursor = db.execute(f"SELECT {selected} FROM jobs JOIN sweep_jobs USING (key) "
                                 "WHERE sweep_jobs.sweep = ? ORDER BY key", [sweep])
         names = [d[0] for d in cursor.description]
         rows = [dict(zip(names, values)) for values in cursor.fetchall()]
@@ -168,7 +172,7 @@ def read_jobs(path, sweep: str | None = None) -> list[dict[str, Any]]:
         db.close()
     for row in rows:
         for name in JSON_COLUMNS:
-            if row[name] is not None:
+            if row.get(name) is not None:
                 row[name] = json.loads(row[name])
     return rows
 
@@ -179,13 +183,19 @@ def _tables(db) -> set[str]:
                                            "WHERE table_name IN ('jobs', 'sweep_jobs')").fetchall()}
 
 
-def _check_schema(db, path: Path) -> None:
-    """Refuse a file whose tables are not this version's store."""
+def _check_schema(db, path: Path, columns: Sequence[str] | None = None) -> None:
+    """Refuse a file whose tables are not this version's store (with ``columns``: whose
+    jobs table lacks one of them)."""
     if _tables(db) != {"jobs", "sweep_jobs"}:
         raise SwarmtopoError(f"{path}: not a sweep result store (it lacks the jobs and sweep_jobs tables)")
     found = tuple(name for (name,) in db.execute(
         "SELECT column_name FROM information_schema.columns WHERE table_name = 'jobs' ORDER BY ordinal_position"
     ).fetchall())
+    if columns is not None:
+        missing = [n for n in columns if n not in found]
+        if missing:
+            raise SwarmtopoError(f"{path}: its jobs table lacks the columns {', '.join(missing)}")
+        return
     if found != _NAMES:
         missing = [n for n in _NAMES if n not in found]
         extra = [n for n in found if n not in _NAMES]
