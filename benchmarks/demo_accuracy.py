@@ -1,8 +1,8 @@
 """Accuracy of the map on the paper's Fig. "encmds" arena (the demo's), default against paper.
 
 500 mm square with one centred hole, or none; 200 agents; 20 s (the paper's figure:
-shorter than one automatic window of 20 encounters per agent, so the default maps the
-log whole, with no vote) and 30 s (the demo).
+shorter than an automatic window of 20 encounters per agent, so the default's window
+scales 1 and 1.25 map the log whole and scale 0.75 gives two windows) and 30 s (the demo).
 Prints how many maps give the exact beta_1 over seeds 0..N-1 for swarmtopo's default
 pipeline and for the paper's (``swarmtopo map --paper``: no per-hop cost, the
 paper's Theta*) and its classifier form trained our way (``paper-form``).  These

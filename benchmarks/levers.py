@@ -2,23 +2,26 @@
 
 Each variant maps the tuning cases of ``swarmtopo-accuracy/1`` (inside
 ``tuning_session``: reporting cases are closed; no L-shaped holes) from logs stripped of
-ground truth, and the ratio classifier (q_1, tau_1, gamma_1) is fitted for each variant
-on its own maps (``experiments.tuning.fit_thresholds``), so a variant is compared at
-its best.  Printed per variant: fitted exact (beta_0, beta_1), the 4-fold
-cross-validated count (thresholds fitted without each quarter), per-cell counts, counts
-per hole family (the family of a case's holes; "no hole" for none) and seconds per map.
+ground truth, and the ratio classifier (q_1, tau_1) is fitted for each variant on its
+own maps (``experiments.tuning.fit_thresholds``), so a variant is compared at its
+best.  Printed per variant and per way of pooling the windows (mean scores, as the
+shipped classifier, and the lower median of the windows' counts, as before): fitted
+exact (beta_0, beta_1), the 4-fold cross-validated count (thresholds fitted without
+each quarter), per-cell counts, counts per hole family (the family of a case's holes;
+"no hole" for none) and seconds per map.
 
 Variants (all: hybrid metric, maxmin, automatic landmarks, h = r_d / v_c, automatic
 diffusion time, wall following x 2):
 
-* ``default`` -- ``MapConfig()``.
+* ``default`` -- ``MapConfig()`` (windows of 15, 20 and 25 encounters per agent).
 * ``20s`` -- fixed 20 s windows overlapping by half (the previous default).
 * ``whole`` -- the whole log at once.
 * ``quarter`` -- automatic windows started every quarter window (twice the windows).
 * ``draws`` -- three landmark draws (seeds) per window, all their counts voted;
   ``draws-K`` K draws.  The map's seed is the case's; draw d uses seed + d.
 * ``seed+D`` -- the default with the landmark draw of seed + D: one of ``draws-K``'s
-  draws on its own (``default`` is draw 0), to measure the spread a draw causes.
+  draws on its own (``default`` is draw 0), to measure the spread a draw causes;
+  ``VARIANT@D`` is any variant with the landmark draw of seed + D.
 * ``switch`` -- a cost per change of agent instead of per hop: every pair of one
   agent's events joined with D_tau(its chain time) + h (the paper's all-pairs graph plus
   h: a path pays h once per agent it rides), built literally, O(m^2) per agent; wall
@@ -57,6 +60,16 @@ diffusion time, wall following x 2):
   in one vote; ``mix-K1-K2-...`` those of K1, K2, ..., and ``mix-K1-...-whole`` with
   the whole log too (each K at window scale 1; ``window_scales=S1,S2`` is the
   pipeline's own form of ``mix-K1-K2``, K_i = S_i x ``window_encounters``).
+* ``hub`` -- h paid per change of agent instead of per hop, with the default's per-gap
+  weights: each event a hub joined to one copy per agent at h / 2, an agent's
+  consecutive copies joined by D_tau of the gap (wall following x 2) without h;
+  Vietoris-Rips on these distances among the default's landmarks.  (``switch`` charges
+  D_tau of the whole ride instead.)
+* ``tcorr-S`` -- Vietoris-Rips on the landmark distances with their time separation
+  taken out: within a window, events at one place but dt apart are about c + b dt
+  apart (measured against the simulations' truth with ``benchmarks/metric_vs_truth.py``),
+  so d becomes sqrt((d - c)^2 - (S b dt)^2), c + b dt the lower envelope of d against dt
+  fitted on the window's landmarks.
 * ``witness`` -- lazy witness complex (nu = 1) on the landmarks with every event of the
   window as a witness, instead of Vietoris-Rips: edge (i, j) enters at
   min_w max(d(w, l_i), d(w, l_j)) - m_w, m_w the distance of w to its nearest landmark.
@@ -76,7 +89,7 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 from scipy import sparse
-from scipy.sparse.csgraph import minimum_spanning_tree, shortest_path
+from scipy.sparse.csgraph import dijkstra, minimum_spanning_tree, shortest_path
 
 from swarmtopo import graph as G
 from swarmtopo import pipeline as P
@@ -88,7 +101,7 @@ from swarmtopo.experiments.sweep import build_arena, stripped_log
 from swarmtopo.experiments.tuning import TuningMap, exact, fit_thresholds
 from swarmtopo.persistence import Diagram, rips_persistence
 from swarmtopo.pipeline import WHOLE_LOG, MapConfig, map_encounters, mean_agent_gap, resolve_window
-from swarmtopo.ratio import WindowBars
+from swarmtopo.ratio import POOLINGS, WindowBars
 from swarmtopo.sim import simulate
 
 
@@ -213,6 +226,63 @@ def _geodesic(log, seed):
     return _other_filtration(log, seed, lambda window, sub: _geodesic_values(window.landmarks.distances))
 
 
+def _hub_distances(log, window, hop_cost: float, diffusion_time: float, wall_follow_weight) -> np.ndarray:
+    """Distances among a window's landmarks when h is paid per change of agent: every
+    event is a hub joined to one copy per agent at h / 2, consecutive copies of one
+    agent joined by the default's gap weight without h (D_tau of the random-walk part
+    plus C x the wall-following part), so riding one agent through its encounters pays
+    no h (zero weights, inside stops, become 1e-9)."""
+    chains = G.chain_edges(log, "hybrid", (window.t0, window.t1))
+    n = len(chains.t)
+    if wall_follow_weight is None:
+        weight = G.diffusive_weight(chains.weight, diffusion_time)
+    else:
+        following = np.minimum(G.state_time(log, G.WF, chains.agent, chains.t[chains.first],
+                                            chains.t[chains.second]), chains.weight)
+        weight = G.diffusive_weight(chains.weight - following, diffusion_time) + wall_follow_weight * following
+    side_a = log.a[chains.event_index]
+    first = n + 2 * chains.first + (side_a[chains.first] != chains.agent)
+    second = n + 2 * chains.second + (side_a[chains.second] != chains.agent)
+    hubs = np.arange(n)
+    u = np.concatenate([first, hubs, hubs])
+    v = np.concatenate([second, n + 2 * hubs, n + 2 * hubs + 1])
+    w = np.maximum(np.concatenate([weight, np.full(2 * n, hop_cost / 2)]), 1e-9)
+    graph = sparse.coo_matrix((np.r_[w, w], (np.r_[u, v], np.r_[v, u])), shape=(3 * n, 3 * n)).tocsr()
+    sources = np.searchsorted(chains.event_index, window.landmark_events)
+    values = dijkstra(graph, directed=False, indices=sources)[:, sources]
+    values = np.minimum(values, values.T)
+    np.fill_diagonal(values, 0.0)
+    return values
+
+
+def _hub(log, seed):
+    hop_cost = P.resolve_hop_cost(log, None)[0]
+    diffusion_time = P.resolve_diffusion_time(mean_agent_gap(log), None)[0]
+    return _other_filtration(log, seed, lambda window, sub: _hub_distances(
+        log, window, hop_cost, diffusion_time, P.WALL_FOLLOW_WEIGHT))
+
+
+def _time_corrected(distances: np.ndarray, times: np.ndarray, share: float) -> np.ndarray:
+    """sqrt(max(0, (d - c)^2 - (share b |t_i - t_j|)^2)): the landmark distances with the
+    time separation taken out, c + b dt the lower envelope of d against dt (the 2 % quantile
+    of d in 12 bins of dt up to its 90th percentile, fitted by a line)."""
+    gap = np.abs(times[:, None] - times[None, :])
+    upper = np.triu_indices(len(distances), 1)
+    d, dt = distances[upper], gap[upper]
+    edges = np.quantile(dt, np.linspace(0.0, 0.9, 13))
+    points = [(np.median(dt[inside]), np.quantile(d[inside], 0.02))
+              for inside in ((dt >= lo) & (dt <= hi) for lo, hi in zip(edges[:-1], edges[1:])) if inside.sum() >= 20]
+    slope, offset = np.polyfit(*np.array(points).T, 1)
+    values = np.sqrt(np.maximum(np.maximum(distances - offset, 0.0) ** 2 - (share * max(slope, 0.0) * gap) ** 2, 0.0))
+    np.fill_diagonal(values, 0.0)
+    return values
+
+
+def _tcorr(log, seed, share):
+    return _other_filtration(log, seed, lambda window, sub: _time_corrected(
+        window.landmarks.distances, log.t[window.landmark_events], share))
+
+
 def _planar_distances(distances: np.ndarray, dim: int) -> np.ndarray:
     """Euclidean distances between the landmarks' classical MDS coordinates in R^dim."""
     points = mds(distances, dim=dim, method="classical").coords
@@ -321,6 +391,9 @@ def _override(text):
 
 
 def _variant(name):
+    if "@" in name:
+        base, offset = name.rsplit("@", 1)
+        return lambda log, seed: _variant(base)(log, seed + int(offset))
     if "=" in name:
         return _override(name)
     if name.startswith("draws-"):
@@ -343,6 +416,8 @@ def _variant(name):
         return lambda log, seed: _dtm(log, seed, int(name.split("-", 1)[1]))
     if name.startswith("mds-"):
         return lambda log, seed: _mds(log, seed, int(name.split("-", 1)[1]))
+    if name.startswith("tcorr-"):
+        return lambda log, seed: _tcorr(log, seed, float(name.split("-", 1)[1]))
     if name.startswith("log-"):
         return lambda log, seed: _log_gaps(log, seed, float(name.split("-", 1)[1]))
     if name.startswith(("diffusive-", "switch-")):
@@ -378,6 +453,7 @@ VARIANTS = {
     "hop-double": _hop_times(2.0),
     "dense": _dense,
     "mix": _window_mix,
+    "hub": _hub,
 }
 
 
@@ -405,7 +481,8 @@ def main() -> None:
     parser.add_argument("--per-cell", type=int, default=12)
     parser.add_argument("--variants", nargs="+", default=["default", "20s", "whole", "quarter", "draws", "switch"],
                         help=f"{', '.join(sorted(VARIANTS))}, diffusive-C, switch-C, log-C, wall-C, wall-none, "
-                             "smooth-HOW-K, paths-C, dtm-K, mds-D, mix-K1-K2[-whole], draws-K, seed+D or FIELD=VALUE")
+                             "smooth-HOW-K, paths-C, dtm-K, mds-D, mix-K1-K2[-whole], draws-K, seed+D, tcorr-S or FIELD=VALUE; "
+                             "VARIANT@D: with the landmark draw of seed + D")
     parser.add_argument("--cells", nargs="+", metavar="TEXT",
                         help="only the cells whose name contains one of these (default: all)")
     parser.add_argument("--processes", type=int, default=2)
@@ -420,21 +497,23 @@ def main() -> None:
         with ProcessPoolExecutor(args.processes) as pool:
             results = list(pool.map(_run, tasks))
         maps = [m for m, _, _, _ in results if m is not None]
-        fit = fit_thresholds(maps)
-        right = exact(maps, fit.thresholds)
-        fold = np.arange(len(maps)) % 4
-        cv = sum(int(exact([m for m, f in zip(maps, fold) if f == k],
-                           fit_thresholds([m for m, f in zip(maps, fold) if f != k]).thresholds).sum())
-                 for k in range(4))
-        per_cell = [int(sum(ok for m, ok in zip(maps, right) if m.cell == CELLS[c].name)) for c in cells]
         family_of = [f for m, _, f, _ in results if m is not None]
-        per_family = ", ".join(f"{f} {sum(ok for g, ok in zip(family_of, right) if g == f)}/{family_of.count(f)}"
-                               for f in sorted(set(family_of)))
         seconds = np.mean([s for _, _, _, s in results])
-        th = fit.thresholds
-        print(f"{name}: {int(right.sum())}/{len(tasks)} exact (q {th.q:g}, tau {th.tau:g}, gamma {th.gamma:g}); "
-              f"4-fold CV {cv}/{len(tasks)}; per cell {per_cell}; per hole family {per_family}; "
-              f"{seconds:.2f} s per map", flush=True)
+        for pooling in POOLINGS:
+            fit = fit_thresholds(maps, pooling)
+            right = exact(maps, fit.thresholds, pooling)
+            fold = np.arange(len(maps)) % 4
+            cv = sum(int(exact([m for m, f in zip(maps, fold) if f == k],
+                               fit_thresholds([m for m, f in zip(maps, fold) if f != k], pooling).thresholds,
+                               pooling).sum())
+                     for k in range(4))
+            per_cell = [int(sum(ok for m, ok in zip(maps, right) if m.cell == CELLS[c].name)) for c in cells]
+            per_family = ", ".join(f"{f} {sum(ok for g, ok in zip(family_of, right) if g == f)}/{family_of.count(f)}"
+                                   for f in sorted(set(family_of)))
+            th = fit.thresholds
+            print(f"{name}, {pooling}: {int(right.sum())}/{len(tasks)} exact (q {th.q:g}, tau {th.tau:g}); "
+                  f"4-fold CV {cv}/{len(tasks)}; per cell {per_cell}; per hole family {per_family}; "
+                  f"{seconds:.2f} s per map", flush=True)
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""Ratio classifier: hand-made diagrams, the median vote, scale invariance, files."""
+"""Ratio classifier: hand-made diagrams, mean and median pooling, scale invariance, files."""
 
 import numpy as np
 import pytest
@@ -8,80 +8,73 @@ from hypothesis import strategies as st
 from swarmtopo.classify import load_classifier
 from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.persistence import Diagram
-from swarmtopo.ratio import (MAX_MARGIN, RatioClassifier, RatioThresholds, WindowBars, counted_bars, median_vote,
-                             vote, window_margin)
+from swarmtopo.ratio import (LOG_RATIO_CAP, MAX_MARGIN, RatioClassifier, RatioThresholds, WindowBars, longest_bars,
+                             median_vote, pooled_scores, score_margin, vote, window_scores)
 
-TH = RatioThresholds(q=0.5, tau=1e-9, rho=2.0, kappa=1.0)  # quantile test off in effect (tau ~ 0)
+TH = RatioThresholds(q=0.5, tau=2.0)
 
 
 def diagram(h1):
     return Diagram(pairs=(np.array([[0.0, np.inf]]), np.array(h1, dtype=float).reshape(-1, 2)), backend="test")
 
 
-def test_counted_bars_hand_computed():
-    # bars sorted by decreasing length: [1, 5] (ratio 5, length 4), [2, 3.5] (1.75, 1.5),
-    # [0.5, 1.5] (3, 1), [1, inf]
+def windows_of(*h1s):
+    return [WindowBars(diagram(h1), 1.0) for h1 in h1s]
+
+
+def test_window_scores_hand_computed():
+    # finite lengths 4, 1.5, 1: median l_q = 1.5; scores ln(4/1.5), 0 (ln 1), 0 (ln(1/1.5) clipped);
+    # the infinite bar scores the cap
     d = diagram([[1, 5], [2, 3.5], [0.5, 1.5], [1, np.inf]])
-    pairs = d[1]
-    counted = counted_bars(d, 1, cover_radius=0.9, th=TH)
-    # ratio > 2 and length > 0.9: [1, 5] and [0.5, 1.5]; the infinite bar always counts
-    got = {tuple(pairs[i]) for i in counted}
-    assert got == {(1.0, 5.0), (0.5, 1.5), (1.0, np.inf)}
-    # a covering radius of 1.2 puts [0.5, 1.5] (length 1) under kappa r_cover
-    assert {tuple(pairs[i]) for i in counted_bars(d, 1, 1.2, TH)} == {(1.0, 5.0), (1.0, np.inf)}
+    assert window_scores(d, 1, 0.5) == pytest.approx([LOG_RATIO_CAP, np.log(4 / 1.5), 0.0, 0.0])
+    assert len(window_scores(diagram(np.empty((0, 2))), 1, 0.5)) == 0
 
 
-def test_quantile_test_hand_computed():
-    # lengths 4, 1.5, 1 (finite): median l_q = 1.5; tau = 2 counts lengths > 3: only [1, 5]
+def test_window_count_threshold_and_margin_hand_computed():
+    # lengths 4, 1.5, 1: tau = 2 counts lengths > 2 x 1.5 = 3: only [1, 5]
     d = diagram([[1, 5], [2, 3.5], [0.5, 1.5]])
-    th = RatioThresholds(q=0.5, tau=2.0)
-    assert [tuple(d[1][i]) for i in counted_bars(d, 1, 1.0, th)] == [(1.0, 5.0)]
-    model = RatioClassifier({1: th})
-    assert model.length_thresholds(d, 1.0) == {1: pytest.approx(3.0)}
-    # the margin: [1, 5] is ln(4/3) above, [2, 3.5] ln(2) below -> ln(4/3)
-    assert window_margin(d, 1, 1.0, th) == pytest.approx(np.log(4 / 3))
+    model = RatioClassifier({1: TH})
+    assert model.betti(d) == {1: 1}
+    assert model.length_thresholds(d) == {1: pytest.approx(3.0)}
+    # [1, 5] is ln(4/3) above the threshold, [2, 3.5] (score 0) ln 2 below: the margin is ln(4/3)
+    assert model.margin(d, None, 1) == pytest.approx(np.log(4 / 3))
+    assert model.margin(diagram(np.empty((0, 2))), None, 1) == MAX_MARGIN
+    # the infinite bar always counts (tau < 1000)
+    assert model.betti(diagram([[1, 5], [2, 3.5], [0.5, 1.5], [1, np.inf]])) == {1: 2}
 
 
-def test_gap_rule_hand_computed():
-    # lengths 10, 9, 3, 2.8, 1, 1, 1 and an infinite bar; tau ~ 0: every bar a candidate.
-    # Gaps ln(10/9), ln 3, ln(3/2.8), ln 2.8, 0, 0, 0 (none after the last): the largest,
-    # ln 3 after the 2nd bar, cuts -> the two longest and the infinite bar count.
-    d = diagram([[1, 11], [1, 10], [1, 4], [1, 3.8], [1, 2], [2, 3], [3, 4], [1, np.inf]])
-    th = RatioThresholds(q=0.5, tau=1e-9, gamma=1.5)
-    assert {tuple(d[1][i]) for i in counted_bars(d, 1, 1.0, th)} == {(1.0, 11.0), (1.0, 10.0), (1.0, np.inf)}
-    # margin: the largest gap ln 3 over the next largest ln 2.8 and over ln 1.5
-    assert window_margin(d, 1, 1.0, th) == pytest.approx(min(np.log(3 / 2.8), np.log(3 / 1.5)))
-    # gamma above every gap: only the infinite bar
-    assert [tuple(d[1][i]) for i in counted_bars(d, 1, 1.0, RatioThresholds(0.5, 1e-9, gamma=3.5))] == [(1.0, np.inf)]
-    # a floor: l_q = median(10, 9, 3, 2.8, 1, 1, 1) = 2.8, tau 1.1 -> candidates are the
-    # lengths > 3.08, 10 and 9; the largest gap among them, after 9, cuts: 2 (+ inf)
-    assert len(counted_bars(d, 1, 1.0, RatioThresholds(0.5, 1.1, gamma=1.0))) == 3
-    # without the gap rule every candidate counts: with tau ~ 0, all 7 (+ inf)
-    assert len(counted_bars(d, 1, 1.0, RatioThresholds(0.5, 1e-9))) == 8
+def test_mean_pooling_hand_computed_against_the_median():
+    # window 1: lengths 8, 2, 2, 1 (median 2) -> scores ln 4, 0, 0, 0; own count 1 (8 > 4)
+    # window 2: lengths 3, 2, 1 (median 2)    -> scores ln 1.5, 0, 0; own count 0 (3 <= 4)
+    # pooled: S_1 = (ln 4 + ln 1.5) / 2 = ln(sqrt 6) > ln 2 -> 1 hole; the lower median of (1, 0) is 0
+    w = windows_of([[0, 8], [0, 2], [1, 3], [0, 1]], [[0, 3], [1, 3], [0, 1]])
+    assert pooled_scores([x.diagram for x in w], 1, 0.5) == pytest.approx([np.log(np.sqrt(6)), 0, 0, 0])
+    mean, median = RatioClassifier({1: TH}), RatioClassifier({1: TH}, pooling="median")
+    assert mean.pooled_betti(w) == {1: 1} and median.pooled_betti(w) == {1: 0}
+    betti, rep, counts = vote(mean, w)
+    assert betti == {1: 1} and counts == {1: [1, 0]} and rep == 0  # the window that agrees
+    assert vote(median, w)[:2] == ({1: 0}, 1)
+    # agreement 1/2; margin: S_1 is ln(sqrt 6) - ln 2 above, S_2 = 0 is ln 2 below
+    assert mean.region_features(w, 1) == pytest.approx([0.5, np.log(np.sqrt(6) / 2), 2.0])
 
 
-def test_version_1_files_read_with_the_gap_rule_off():
-    old = {"format": "swarmtopo-ratio-classifier/1",
-           "thresholds": {"1": {"q": 0.5, "tau": 2.0, "rho": 1.0, "kappa": 0.0}}}
-    model = RatioClassifier.from_json(old)
-    assert model.thresholds_[1].gamma == 0.0
-    assert model.to_json()["format"] == "swarmtopo-ratio-classifier/2"
+def test_a_missing_rank_scores_zero():
+    # window 1 has two long bars, window 2 one: S_2 = (ln 5 + 0) / 2 = ln sqrt 5 > ln 2
+    w = windows_of([[0, 10], [0, 10], [0, 2], [0, 2], [0, 2]], [[0, 10], [0, 2], [0, 2]])
+    assert RatioClassifier({1: TH}).pooled_betti(w) == {1: 2}
+    assert RatioClassifier({1: RatioThresholds(0.5, 2.5)}).pooled_betti(w) == {1: 1}
 
 
-def test_bar_born_at_zero_has_infinite_ratio():
-    d = diagram([[0.0, 2.0]])
-    assert len(counted_bars(d, 1, 1.0, TH)) == 1
-    assert len(counted_bars(d, 1, 3.0, TH)) == 0  # but still needs the length
-
-
-def test_margin_hand_computed():
-    # one counted bar [1, 5]: ratio 5 vs rho 2 -> ln 2.5; length 4 vs kappa r = 1 -> ln 4:
-    # it flips when the nearer test fails, ln 2.5.  One uncounted bar [2, 3] (ratio 1.5,
-    # length 1 vs 0.5): it needs both tests, so its distance is max(ln(2/1.5), -ln 2) = ln(4/3).
-    d = diagram([[1, 5], [2, 3]])
-    m = window_margin(d, 1, cover_radius=0.5, th=RatioThresholds(q=0.5, tau=0.01, rho=2.0, kappa=1.0))
-    assert m == pytest.approx(min(np.log(2.5), np.log(4 / 3)))
-    assert window_margin(diagram(np.empty((0, 2))), 1, 1.0, TH) == MAX_MARGIN
+def test_score_margin_and_longest_bars_hand_computed():
+    scores = np.array([2.0, 1.0, 0.2])
+    # ln tau = 0.5: two counted; the last counted is 1.0 - 0.5 above, the first uncounted 0.5 - 0.2 below
+    assert score_margin(scores, np.exp(0.5)) == pytest.approx(0.3)
+    # ln tau = 1.2: one counted, 2.0 - 1.2 above; 1.2 - 1.0 below
+    assert score_margin(scores, np.exp(1.2)) == pytest.approx(0.2)
+    assert score_margin(np.array([10.0]), 2.0) == MAX_MARGIN
+    d = diagram([[1, 2], [0, 5], [1, np.inf], [2, 6]])
+    assert [tuple(d[1][i]) for i in longest_bars(d, 1, 2)] == [(1.0, np.inf), (0.0, 5.0)]
+    assert list(longest_bars(d, 1, 0)) == []
 
 
 def test_median_vote_is_the_lower_median():
@@ -91,12 +84,12 @@ def test_median_vote_is_the_lower_median():
     assert median_vote([2, 2, 1, 3]) == 2
 
 
-def test_vote_picks_an_agreeing_window_with_the_largest_margin():
-    model = RatioClassifier({1: TH})
-    windows = [WindowBars(diagram([[1, 5], [1, 2.1]]), 0.5),   # 2 bars counted, nearest barely
-               WindowBars(diagram([[1, 8]]), 0.5),             # 1 bar, far from both thresholds
-               WindowBars(diagram([[1, 2.5]]), 0.5)]           # 1 bar, ratio 2.5 close to 2
-    betti, rep, counts = vote(model, windows)
+def test_vote_picks_the_agreeing_window_with_the_largest_margin():
+    model = RatioClassifier({1: TH}, pooling="median")
+    w = windows_of([[0, 9], [0, 4.1], [0, 1], [0, 1], [0, 1]],  # 2 counted, the second barely (4.1 > 2)
+                   [[0, 20], [0, 1], [0, 1]],                     # 1, far from the threshold
+                   [[0, 2.5], [0, 1], [0, 1]])                    # 1, ratio 2.5 close to 2
+    betti, rep, counts = vote(model, w)
     assert counts == {1: [2, 1, 1]} and betti == {1: 1} and rep == 1
 
 
@@ -105,15 +98,24 @@ def test_vote_without_windows_is_an_error():
         vote(RatioClassifier({1: TH}), [])
 
 
+bar_lists = st.lists(st.tuples(st.floats(0.1, 10), st.floats(0.01, 10)), max_size=12)
+
+
 @settings(max_examples=60, deadline=None)
-@given(bars=st.lists(st.tuples(st.floats(0.1, 10), st.floats(0.01, 10)), max_size=12),
-       cover=st.floats(0.05, 5), c=st.floats(0.01, 100))
-def test_counts_are_scale_invariant(bars, cover, c):
-    # multiplying every distance by c multiplies births, deaths and r_cover by c
-    h1 = [[b, b + length] for b, length in bars]
-    for th in (RatioThresholds(0.5, 2.0, 2.0, 1.5), RatioThresholds(0.5, 1.5, gamma=1.2)):
-        model = RatioClassifier({1: th})
-        assert model.betti(diagram(h1), cover) == model.betti(diagram(np.array(h1).reshape(-1, 2) * c), cover * c)
+@given(bars=st.lists(bar_lists, min_size=1, max_size=4), c=st.floats(0.01, 100),
+       tau=st.floats(1.0, 20.0), q=st.sampled_from([0.5, 0.7, 0.9]))
+def test_pooled_counts_are_scale_invariant_and_between_the_windows_counts(bars, c, tau, q):
+    # multiplying every distance by c multiplies births and deaths by c
+    h1s = [np.array([[b, b + length] for b, length in w]).reshape(-1, 2) for w in bars]
+    model = RatioClassifier({1: RatioThresholds(q, tau)})
+    pooled = model.pooled_betti(windows_of(*h1s))[1]
+    assert pooled == model.pooled_betti(windows_of(*(h * c for h in h1s)))[1]
+    # every rank's mean score passes when it passes in every window, fails when it fails in every one
+    own = [model.betti(diagram(h))[1] for h in h1s]
+    assert min(own) <= pooled <= max(own)
+    if len(h1s) == 1:  # one window: both poolings are the window's own count
+        assert pooled == own[0] == RatioClassifier({1: RatioThresholds(q, tau)}, pooling="median").pooled_betti(
+            windows_of(*h1s))[1]
 
 
 def test_calibration_and_json_round_trip(tmp_path):
@@ -122,35 +124,52 @@ def test_calibration_and_json_round_trip(tmp_path):
     regions, correct = [], []
     for _ in range(60):
         clean = rng.random() < 0.5
-        bars = [[1, 6]] if clean else [[1, 2.05], [1, 1.95]]
-        regions.append([WindowBars(diagram(bars), 0.5)] * 3)
+        # clean: a bar 20 x the median, a margin of ln 2; unsure: one 2.05 x, ln(2.05 / 2) above tau
+        bars = [[1, 21], [1, 2], [1, 2]] if clean else [[1, 3.05], [1, 2], [1, 2]]
+        regions.append(windows_of(bars, bars, bars))
         correct.append(clean or rng.random() < 0.3)
     model.calibrate(np.array([model.region_features(r, 1) for r in regions]), correct,
                     beta0_correct=[True] * 59 + [False])
-    sure = model.region_confidence([WindowBars(diagram([[1, 6]]), 0.5)] * 3)[1]
-    unsure = model.region_confidence([WindowBars(diagram([[1, 2.05], [1, 1.95]]), 0.5)] * 3)[1]
+    sure = model.region_confidence(windows_of(*[[[1, 21], [1, 2], [1, 2]]] * 3))[1]
+    unsure = model.region_confidence(windows_of(*[[[1, 3.05], [1, 2], [1, 2]]] * 3))[1]
     assert 0 <= unsure < sure <= 1 and sure > 0.8 and unsure < 0.6
     assert model.beta0_confidence() == pytest.approx(60 / 62)
     path = tmp_path / "c.json"
-    from swarmtopo.io import write_json
-    write_json(model.to_json(), path)
+    model.save(path)
     again = load_classifier(path)
-    assert isinstance(again, RatioClassifier)
+    assert isinstance(again, RatioClassifier) and again.pooling == "mean"
     assert again.to_json() == model.to_json()
 
 
-def test_bad_thresholds_and_files_are_input_errors(tmp_path):
-    with pytest.raises(InputError, match="rho >= 1"):
-        RatioClassifier({1: RatioThresholds(0.5, 2.0, rho=0.5)})
+def test_earlier_formats_read_as_median_pooling_when_their_gates_are_off():
+    for fmt, extra in (("swarmtopo-ratio-classifier/1", {}), ("swarmtopo-ratio-classifier/2", {"gamma": 0.0})):
+        old = {"format": fmt, "thresholds": {"1": {"q": 0.5, "tau": 2.0, "rho": 1.0, "kappa": 0.0, **extra}}}
+        model = RatioClassifier.from_json(old)
+        assert model.pooling == "median" and model.thresholds_[1] == TH
+        assert model.to_json()["format"] == "swarmtopo-ratio-classifier/3"
+    gated = {"format": "swarmtopo-ratio-classifier/2",
+             "thresholds": {"1": {"q": 0.5, "tau": 2.0, "rho": 2.0, "kappa": 0.0, "gamma": 0.0}}}
+    with pytest.raises(InputError, match="old.json.*thresholds.1.*no longer applied"):
+        RatioClassifier.from_json(gated, source="old.json")
+
+
+def test_bad_thresholds_and_files_are_input_errors():
+    with pytest.raises(InputError, match="1 <= tau < 1000"):
+        RatioClassifier({1: RatioThresholds(0.5, 0.5)})
+    with pytest.raises(InputError, match="1 <= tau < 1000"):
+        RatioClassifier({1: RatioThresholds(0.5, 1000.0)})
     with pytest.raises(InputError, match="q <= 1"):
         RatioClassifier({1: RatioThresholds(1.5, 2.0)})
-    with pytest.raises(InputError, match="gamma 0 or >= 1"):
-        RatioClassifier({1: RatioThresholds(0.5, 2.0, gamma=0.5)})
+    with pytest.raises(InputError, match="pooling"):
+        RatioClassifier({1: TH}, pooling="max")
     with pytest.raises(InputError, match="malformed"):
-        RatioClassifier.from_json({"format": "swarmtopo-ratio-classifier/1", "thresholds": {"1": {"rho": "x"}}})
+        RatioClassifier.from_json({"format": "swarmtopo-ratio-classifier/3", "thresholds": {"1": {"q": "x"}}})
+    with pytest.raises(InputError, match="pooling"):
+        RatioClassifier.from_json({"format": "swarmtopo-ratio-classifier/3", "pooling": "mode",
+                                   "thresholds": {"1": {"q": 0.5, "tau": 2.0}}})
 
 
-def test_shipped_default_is_a_calibrated_ratio_classifier():
+def test_shipped_default_is_a_calibrated_mean_pooled_ratio_classifier():
     model = load_classifier("default")
-    assert isinstance(model, RatioClassifier)
+    assert isinstance(model, RatioClassifier) and model.pooling == "mean"
     assert model.calibration_.get("1") and model.beta0_confidence() is not None

@@ -3,7 +3,7 @@ the literal classifier at every grid point; cross-fitted calibration."""
 
 import numpy as np
 
-from swarmtopo.experiments.tuning import (GAMMA_GRID, Q_GRID, TAU_GRID, TuningMap, calibrated_classifier, exact,
+from swarmtopo.experiments.tuning import (Q_GRID, TAU_GRID, TuningMap, calibrated_classifier, exact,
                                          fit_thresholds, grid_estimates)
 from swarmtopo.persistence import Diagram
 from swarmtopo.ratio import RatioThresholds, WindowBars
@@ -28,35 +28,33 @@ def synthetic_maps(n, rng):
 
 def test_fit_finds_a_threshold_between_noise_and_holes():
     maps = synthetic_maps(40, np.random.default_rng(0))
-    fit = fit_thresholds(maps)
-    assert fit.accuracy == 1.0 and exact(maps, fit.thresholds).all()
-    # the median length is ~1 (noise dominates), holes are >= 8: without the gap rule
-    # tau must sit in between; a threshold outside that gap is wrong somewhere
-    th = fit.thresholds
-    assert th.gamma > 0 or 1.5 < th.tau < 8.0
-    assert not exact(maps, RatioThresholds(th.q, 20.0)).all()
-    assert not exact(maps, RatioThresholds(th.q, 1.01)).all()
-    # the gap rule finds the holes whatever the floor below them (tau ~ 0: every bar a candidate)
-    holes = [m for m in maps if m.true_betti1 > 0]
-    assert exact(holes, RatioThresholds(0.5, 1e-6, gamma=3.0)).all()
+    for pooling in ("mean", "median"):
+        fit = fit_thresholds(maps, pooling)
+        assert fit.accuracy == 1.0 and exact(maps, fit.thresholds, pooling).all() and fit.pooling == pooling
+        # the median length is ~1 (noise dominates), holes are >= 8: tau must sit in
+        # between; a threshold outside that gap is wrong somewhere
+        th = fit.thresholds
+        assert 1.5 < th.tau < 8.0
+        assert not exact(maps, RatioThresholds(th.q, 20.0), pooling).all()
+        assert not exact(maps, RatioThresholds(th.q, 1.01), pooling).all()
 
 
 def test_vectorised_grid_equals_the_literal_classifier():
-    """grid_estimates at every grid point == the literal counted_bars + lower-median vote,
-    on maps with ties, infinite bars, empty diagrams and windows with no bars to cut."""
+    """grid_estimates at every grid point == the literal classifier's pooled count, both
+    poolings, on maps with ties, infinite bars, empty diagrams and windows with no bars to cut."""
     rng = np.random.default_rng(3)
     maps = synthetic_maps(12, rng)
     tie = np.array([[1.0, 3.0], [2.0, 4.0], [0.5, 2.5], [1.0, 1.5], [1.0, np.inf]])
     odd = (WindowBars(Diagram(pairs=(np.array([[0.0, np.inf]]), tie), backend="test"), 1.0),
            WindowBars(Diagram(pairs=(np.array([[0.0, np.inf]]), np.empty((0, 2))), backend="test"), 1.0))
     maps.append(TuningMap(regions=(odd, maps[0].regions[0]), est_betti0=2, true_betti0=2, true_betti1=2, cell="c"))
-    est = grid_estimates(maps)
     truth = np.array([m.true_betti1 for m in maps])
-    for i, q in enumerate(Q_GRID):
-        for j in range(0, len(TAU_GRID), 7):
-            for k, gamma in enumerate(GAMMA_GRID):
-                literal = exact(maps, RatioThresholds(q, TAU_GRID[j], gamma=gamma))
-                assert np.array_equal(literal, est[:, i, j, k] == truth), (q, TAU_GRID[j], gamma)
+    for pooling in ("mean", "median"):
+        est = grid_estimates(maps, pooling)
+        for i, q in enumerate(Q_GRID):
+            for j in range(0, len(TAU_GRID), 7):
+                literal = exact(maps, RatioThresholds(q, TAU_GRID[j]), pooling)
+                assert np.array_equal(literal, est[:, i, j] == truth), (pooling, q, TAU_GRID[j])
 
 
 def test_cross_fitted_calibration_is_confident_on_clean_maps():

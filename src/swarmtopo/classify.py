@@ -251,11 +251,6 @@ class BettiClassifier(BaseEstimator):
         th = self.theta_[n]
         return confidence_features(bar_lengths(diagram, n), th.q, th.delta, th.tau)[0]
 
-    def counted(self, diagram: Diagram, cover_radius: float | None = None) -> dict[int, np.ndarray]:
-        """Indices of the counted bars of each dimension (longer than the threshold)."""
-        return {n: np.flatnonzero(np.diff(diagram[n], axis=1)[:, 0] > tau)
-                for n, tau in self.thresholds(diagram).items()}
-
     def length_thresholds(self, diagram: Diagram, cover_radius: float | None = None) -> dict[int, float]:
         """Same as :meth:`thresholds` (the interface shared with the ratio classifier)."""
         return self.thresholds(diagram)

@@ -1,46 +1,46 @@
-r"""Scale- and density-free Betti classifier, voted across time windows (swarmtopo's default).
+r"""Scale- and density-free Betti classifier, pooled across time windows (swarmtopo's default).
 
 The paper's classifier compares bar lengths l with l_q + Delta, l_q the q-quantile of
 the diagram's lengths and Delta in seconds; in our benchmark thresholds in seconds did
 not transfer between swarm densities, durations or arena sizes (docs/accuracy.md).
 This classifier uses only ratios, which do not change when every distance is
-multiplied by a constant:
+multiplied by a constant.  In one window, a dim-n bar of length l *scores*
 
-* the **length over the noise scale** l / l_q (the paper's form with Delta = 0): l_q,
-  a quantile of the window's own bar lengths, measures how long the noise loops of
-  this sample are;
-* the **death/birth ratio** pi = d / b: in a Vietoris-Rips filtration of a dense
-  sample a noise loop is filled soon after it is born, while a loop round an obstacle
-  lives until the scale of the obstacle;
-* the **length in covering radii** l / r_cover: subsampling moves no bar by more than
-  2 r_cover, so a bar much shorter than r_cover may be a subsampling artefact.
+    s = ln(l / l_q),   clipped to [0, LOG_RATIO_CAP]
 
-A bar of dimension n is a *candidate* when it passes all three (rho_n = 1 and kappa_n
-= 0 switch the last two off)::
+with l_q the q-quantile of the window's finite dim-n bar lengths (the length of its
+typical noise loop); an infinite bar scores LOG_RATIO_CAP.  The window's scores in
+decreasing order are s_(1) >= s_(2) >= ..., and a rank the window has no bar for
+scores 0.  The window's own count is #{k : s_(k) > ln tau_n}: the paper's form with
+Delta = 0, bars longer than tau_n l_q.
 
-    C_n = { i : l_i > tau_n l_q  and  d_i / b_i > rho_n  and  l_i > kappa_n r_cover }
+A region's log is cut into time windows of several lengths (``MapConfig.window_length``,
+``window_scales``), each mapped on its own.  Its beta_hat_n *pools* them (``pooling``):
 
-(an infinite bar always counts; b = 0 gives pi = inf; l_q is over the finite bars).
-With gamma_n = 0 every candidate counts: beta_hat_n(window) = |C_n|.  With gamma_n >= 1
-the **largest gap** decides: sort the finite bars by length, l_(1) >= l_(2) >= ...,
-let g_k = ln(l_(k) / l_(k+1)) (g = 0 after the last bar: a bar with none below it
-shows no gap), and among the ranks k of candidates take k* = argmax g_k; the
-candidates among the k* longest bars count if g_k* >= ln gamma_n, none otherwise (the
-noise bars' top end moves from sample to sample; a loop round an obstacle may stand
-above it by a gap).  Tuning keeps the gap rule only where it is right more often; for
-the shipped default it was not (docs/tuning.md), so its gamma_1 is 0.
+``"mean"`` (format /3, the default)
+    the mean score of each rank over the W windows, S_k = (1/W) sum_w s^w_(k), and
+    beta_hat_n = #{k : S_k > ln tau_n}.  S is non-increasing (a mean of non-increasing
+    sequences), so the counted ranks are the first ones.  The lower median of the
+    windows' counts (below) throws away how far each window's bars are from the
+    threshold and, with two windows, is their minimum; on the benchmark's tuning cases
+    the mean scored higher (docs/accuracy.md).
+``"median"`` (format /1 and /2 files)
+    the lower median of the windows' own counts.
 
-A region's log is cut into time windows (``MapConfig.window_length``), each window is
-mapped on its own, and the region's beta_hat_n is the **median** of the windows'
-counts (the lower median for an even number of windows).
+Either way the counted bars of a window drawn for the user are its beta_hat_n longest.
 
 Confidence.  For each region the features are the *agreement* a (fraction of
-windows whose count equals the vote) and the *margin* m of the window that represents
-the region: how far, in log units, its count is from changing (without the gap rule:
-its nearest bar's distance to a threshold -- a counted bar flips when any test fails,
-an uncounted one needs every failing test to pass; with it: how much the largest gap
-exceeds the next largest and ln gamma_n), capped at MAX_MARGIN.  P(correct | a, m,
-number of windows) is a logistic regression fitted on the benchmark's tuning maps (:meth:`RatioClassifier.calibrate`).
+windows whose own count equals the vote), the *margin* m, how far in log units the
+vote is from changing -- mean pooling: min(S_beta - ln tau, ln tau - S_{beta+1}) over
+the ranks that exist; median pooling: the nearest bar's distance to the threshold in
+the representative window -- capped at MAX_MARGIN, and the number of windows.
+P(correct | a, m, number of windows) is a logistic regression fitted on the
+benchmark's tuning maps (:meth:`RatioClassifier.calibrate`).
+
+Earlier files (/1, /2) could also gate bars by death/birth ratio, length in covering
+radii and a largest-gap rule; measured over three tuning rounds they never raised the
+rate and the shipped classifiers had them off.  Such files are read when the gates are
+off (as median pooling) and refused otherwise.
 """
 
 from __future__ import annotations
@@ -57,17 +57,20 @@ from ._validate import check_format
 from .errors import InputError, SwarmtopoError
 from .persistence import Diagram
 
-RATIO_FORMAT = "swarmtopo-ratio-classifier/2"
-READ_FORMATS = ("swarmtopo-ratio-classifier/1", RATIO_FORMAT)
-"""Readable formats: /1 files have no gamma (the gap rule off)."""
+RATIO_FORMAT = "swarmtopo-ratio-classifier/3"
+READ_FORMATS = ("swarmtopo-ratio-classifier/1", "swarmtopo-ratio-classifier/2", RATIO_FORMAT)
+"""Readable formats: /1 and /2 files pool by the median of the windows' counts."""
+POOLINGS = ("mean", "median")
 MAX_MARGIN = 3.0
-"""Cap of the log margin of a window's nearest bar (a bar e^3 = 20 times off both
-thresholds is as sure as it gets)."""
+"""Cap of the log margin (a score e^3 = 20 times off the threshold is as sure as it gets)."""
+LOG_RATIO_CAP = float(np.log(1e3))
+"""Cap of a bar's score: a bar 1000 times the typical noise loop (or infinite) is as long as it gets."""
 
 
 @dataclass(frozen=True)
 class WindowBars:
-    """What the classifier reads from one window of one region: its diagram and r_cover."""
+    """What the classifier reads from one window of one region: its diagram (and its r_cover,
+    kept for the record; the ratio classifier reads bar lengths only)."""
 
     diagram: Diagram
     cover_radius: float
@@ -75,83 +78,63 @@ class WindowBars:
 
 @dataclass(frozen=True)
 class RatioThresholds:
-    """(q_n, tau_n, rho_n, kappa_n, gamma_n) of one dimension (module docstring)."""
+    """(q_n, tau_n) of one dimension: a bar counts in its window when l > tau_n l_q."""
 
     q: float
     tau: float
-    rho: float = 1.0
-    kappa: float = 0.0
-    gamma: float = 0.0
 
     def to_json(self) -> dict[str, float]:
-        return {"q": self.q, "tau": self.tau, "rho": self.rho, "kappa": self.kappa, "gamma": self.gamma}
+        return {"q": self.q, "tau": self.tau}
 
 
-def _log_tests(diagram: Diagram, dim: int, cover_radius: float, th: RatioThresholds) -> np.ndarray:
-    """(m, 3) log-ratios of each bar of ``diagram[dim]`` to its three thresholds (> 0:
-    passes); a switched-off test and an infinite bar pass by MAX_MARGIN."""
-    pairs = diagram[dim]
-    birth, death = pairs[:, 0], pairs[:, 1]
-    length = death - birth
-    finite = np.isfinite(death)
-    lq = float(np.quantile(length[finite], th.q)) if finite.any() else 0.0
-    out = np.full((len(pairs), 3), MAX_MARGIN)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        if lq > 0:
-            out[finite, 0] = np.log(length[finite] / (th.tau * lq))
-        if th.rho > 1.0:
-            out[finite, 1] = np.log(death[finite] / (th.rho * birth[finite]))  # b = 0: +inf
-        if th.kappa > 0.0 and cover_radius > 0:
-            out[finite, 2] = np.log(length[finite] / (th.kappa * cover_radius))
-    return out
-
-
-def counted_bars(diagram: Diagram, dim: int, cover_radius: float, th: RatioThresholds) -> np.ndarray:
-    """Indices into ``diagram[dim]`` of the bars that count (module docstring)."""
+def window_scores(diagram: Diagram, dim: int, q: float) -> np.ndarray:
+    """s_(1) >= s_(2) >= ...: the clipped log-ratios ln(l / l_q) of the window's dim-n bars,
+    decreasing (module docstring); empty without bars."""
     if dim > diagram.maxdim or not len(diagram[dim]):
-        return np.empty(0, np.int64)
-    candidate = (_log_tests(diagram, dim, cover_radius, th) > 0).all(axis=1)
-    if th.gamma <= 0:
-        return np.flatnonzero(candidate)
-    finite, order, gaps = ranked_gaps(diagram[dim])
-    out = np.flatnonzero(candidate & ~finite)
-    ranks = np.flatnonzero(candidate[order])
-    if len(ranks):
-        k = ranks[int(np.argmax(gaps[ranks]))]
-        if gaps[k] >= np.log(th.gamma):
-            out = np.union1d(out, order[:k + 1][candidate[order[:k + 1]]])
-    return out
-
-
-def ranked_gaps(pairs: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(finite mask, indices of the finite bars by decreasing length, g_k = ln(l_(k) /
-    l_(k+1)) capped at MAX_MARGIN, 0 after the last)."""
-    length = pairs[:, 1] - pairs[:, 0]
+        return np.empty(0)
+    length = diagram.lengths(dim)
     finite = np.isfinite(length)
-    index = np.flatnonzero(finite)
-    order = index[np.argsort(-length[index], kind="stable")]
-    ranked = length[order]
-    with np.errstate(divide="ignore"):
-        gaps = np.r_[np.log(ranked[:-1] / ranked[1:]), 0.0] if len(ranked) else np.empty(0)
-    return finite, order, np.minimum(gaps, MAX_MARGIN)
+    lq = float(np.quantile(length[finite], q)) if finite.any() else 0.0
+    scores = np.full(len(length), LOG_RATIO_CAP)
+    if lq > 0:
+        with np.errstate(divide="ignore"):
+            scores[finite] = np.clip(np.log(length[finite] / lq), 0.0, LOG_RATIO_CAP)
+    else:  # no finite bar with a length (none, or all of length 0): only infinite bars score
+        scores[finite] = 0.0
+    return np.sort(scores)[::-1]
 
 
-def window_margin(diagram: Diagram, dim: int, cover_radius: float, th: RatioThresholds) -> float:
-    """m: how far, in log units, the window's count is from changing (module docstring)."""
-    if dim > diagram.maxdim or not len(diagram[dim]):
-        return MAX_MARGIN
-    tests = _log_tests(diagram, dim, cover_radius, th)
-    counted = (tests > 0).all(axis=1)
-    # a counted bar flips when its weakest test fails; an uncounted one needs every failing test to pass
-    flip = np.where(counted, tests.min(axis=1), (-np.minimum(tests, 0)).max(axis=1))
-    if th.gamma > 0:  # with the gap rule: how far the largest gap is from losing its place
-        _, order, gaps = ranked_gaps(diagram[dim])
-        ranks = np.flatnonzero(counted[order])
-        if len(ranks):
-            ranked = np.sort(gaps[ranks])[::-1]
-            runner_up = ranked[1] if len(ranked) > 1 else -np.inf
-            return float(min(MAX_MARGIN, ranked[0] - runner_up, ranked[0] - np.log(th.gamma)))
-    return float(min(MAX_MARGIN, flip.min()))
+def pooled_scores(diagrams: Sequence[Diagram], dim: int, q: float) -> np.ndarray:
+    """S_k: the mean over windows of their k-th score, a missing rank scoring 0 (module docstring)."""
+    ranked = [window_scores(d, dim, q) for d in diagrams]
+    out = np.zeros(max((len(s) for s in ranked), default=0))
+    for s in ranked:
+        out[:len(s)] += s
+    return out / max(len(ranked), 1)
+
+
+def count_above(scores: np.ndarray, tau: float) -> int:
+    """#{k : scores_k > ln tau} of non-increasing scores."""
+    return int(np.count_nonzero(scores > np.log(tau)))
+
+
+def score_margin(scores: np.ndarray, tau: float) -> float:
+    """How far, in log units, the count of non-increasing ``scores`` is from changing:
+    the nearer of the last counted and the first uncounted score to ln tau (capped)."""
+    count = count_above(scores, tau)
+    sides = []
+    if count:
+        sides.append(scores[count - 1] - np.log(tau))
+    if count < len(scores):
+        sides.append(np.log(tau) - scores[count])
+    return float(min([MAX_MARGIN, *sides]))
+
+
+def longest_bars(diagram: Diagram, dim: int, count: int) -> np.ndarray:
+    """Indices into ``diagram[dim]`` of its ``count`` longest bars (infinite first; ties by position)."""
+    if dim > diagram.maxdim or count <= 0:
+        return np.empty(0, np.int64)
+    return np.argsort(-diagram.lengths(dim), kind="stable")[:count]
 
 
 def median_vote(counts: Sequence[int]) -> int:
@@ -163,87 +146,102 @@ def median_vote(counts: Sequence[int]) -> int:
 def vote(classifier, windows: Sequence[WindowBars]) -> tuple[dict[int, int], int, dict[int, list[int]]]:
     """A region's beta_hat from its windows: (vote, representative window, counts per window).
 
-    ``classifier`` is a :class:`RatioClassifier` or the paper-form
-    :class:`~swarmtopo.classify.BettiClassifier` (both have ``betti(diagram,
-    cover_radius)`` and ``margin(diagram, cover_radius, n)``).  The vote is the lower
-    median of the windows' counts in each dimension; the representative window is,
-    among those whose count equals the vote in the lowest dimension, the one whose
-    nearest bar is farthest from the threshold (the first on ties).
+    ``classifier`` is a :class:`RatioClassifier` (pooled as its ``pooling`` says) or the
+    paper-form :class:`~swarmtopo.classify.BettiClassifier` (the lower median of the
+    windows' counts).  The representative window is, among those whose own count
+    equals the vote in the lowest dimension (or, if none does, is nearest it), the one
+    whose nearest bar is farthest from the threshold (the first on ties).
     """
     if not windows:
         raise SwarmtopoError("no window of this region has enough events to map")
-    per_window = [classifier.betti(w.diagram, w.cover_radius) for w in windows]
+    per_window = [classifier.betti(w.diagram) for w in windows]
     counts = {n: [c[n] for c in per_window] for n in per_window[0]}
-    betti = {n: median_vote(c) for n, c in counts.items()}
+    pooled = getattr(classifier, "pooled_betti", None)
+    betti = pooled(windows) if pooled else {n: median_vote(c) for n, c in counts.items()}
     if not counts:
         return betti, 0, counts
     key = min(counts)
-    agreeing = [i for i, c in enumerate(counts[key]) if c == betti[key]]
-    margins = [classifier.margin(windows[i].diagram, windows[i].cover_radius, key) for i in agreeing]
-    return betti, agreeing[int(np.argmax(margins))], counts
+    off = [abs(c - betti[key]) for c in counts[key]]
+    nearest = [i for i, x in enumerate(off) if x == min(off)]
+    margins = [classifier.margin(windows[i].diagram, windows[i].cover_radius, key) for i in nearest]
+    return betti, nearest[int(np.argmax(margins))], counts
 
 
 class RatioClassifier:
-    """beta_hat_n from death/birth ratios and covering radii, voted over windows.
+    """beta_hat_n from bar lengths over their window's noise scale, pooled over windows.
 
     Parameters
     ----------
     thresholds
-        ``{n: RatioThresholds(rho_n, kappa_n)}`` for each homology dimension n >= 1.
+        ``{n: RatioThresholds(q_n, tau_n)}`` for each homology dimension n >= 1.
     calibration
         Per dimension ``{"intercept", "agreement", "margin", "windows"}`` of the
         logistic P(correct), and ``"0": {"rate": ...}`` for beta_0; None = uncalibrated.
     provenance
         Free-form record of how it was fitted (name, data, script).
+    pooling
+        ``"mean"`` (pooled scores) or ``"median"`` (lower median of the windows' counts).
     """
 
     def __init__(self, thresholds: dict[int, RatioThresholds], calibration: dict | None = None,
-                 provenance: dict | None = None):
+                 provenance: dict | None = None, pooling: str = "mean"):
         for n, th in thresholds.items():
-            if not (int(n) >= 1 and 0.0 <= th.q <= 1.0 and th.tau > 0 and th.rho >= 1.0 and th.kappa >= 0.0
-                    and (th.gamma == 0.0 or th.gamma >= 1.0)):
-                raise InputError(f"ratio thresholds of dimension {n} out of range "
-                                 "(need 0 <= q <= 1, tau > 0, rho >= 1, kappa >= 0, gamma 0 or >= 1)",
+            if not (int(n) >= 1 and 0.0 <= th.q <= 1.0 and 1.0 <= th.tau < np.exp(LOG_RATIO_CAP)):
+                raise InputError(f"ratio thresholds of dimension {n} out of range (need 0 <= q <= 1, "
+                                 "1 <= tau < 1000)",
                                  column=f"thresholds.{n}", value=th.to_json())
+        if pooling not in POOLINGS:
+            raise InputError(f"unknown pooling; expected one of {', '.join(POOLINGS)}", column="pooling",
+                             value=pooling)
         self.thresholds_ = {int(n): th for n, th in sorted(thresholds.items())}
         self.calibration_ = dict(calibration or {})
         self.provenance_ = dict(provenance or {})
+        self.pooling = pooling
 
     # -- one window --------------------------------------------------------------------
-    def betti(self, diagram: Diagram, cover_radius: float) -> dict[int, int]:
-        """beta_hat_n of one window, for n up to the diagram's maxdim."""
-        return {n: int(len(counted_bars(diagram, n, cover_radius, th)))
+    def betti(self, diagram: Diagram, cover_radius: float | None = None) -> dict[int, int]:
+        """The window's own beta_hat_n, for n up to the diagram's maxdim (``cover_radius``
+        is not used)."""
+        return {n: count_above(window_scores(diagram, n, th.q), th.tau)
                 for n, th in self.thresholds_.items() if n <= diagram.maxdim}
 
-    def counted(self, diagram: Diagram, cover_radius: float) -> dict[int, np.ndarray]:
-        """Indices of the counted bars of each dimension (what the loops are drawn round)."""
-        return {n: counted_bars(diagram, n, cover_radius, th)
-                for n, th in self.thresholds_.items() if n <= diagram.maxdim}
-
-    def length_thresholds(self, diagram: Diagram, cover_radius: float) -> dict[int, float]:
-        """max(tau_n l_q, kappa_n r_cover): the length a counted bar must exceed, seconds
-        (it must also pass the death/birth test)."""
+    def length_thresholds(self, diagram: Diagram, cover_radius: float | None = None) -> dict[int, float]:
+        """tau_n l_q: the length a bar of this window must exceed to count in it, seconds."""
         out = {}
         for n, th in self.thresholds_.items():
             if n > diagram.maxdim:
                 continue
             lengths = diagram.lengths(n)
             finite = lengths[np.isfinite(lengths)]
-            lq = float(np.quantile(finite, th.q)) if len(finite) else 0.0
-            out[n] = max(th.tau * lq, th.kappa * cover_radius)
+            out[n] = th.tau * (float(np.quantile(finite, th.q)) if len(finite) else 0.0)
         return out
 
-    def margin(self, diagram: Diagram, cover_radius: float, n: int) -> float:
-        """m of one window in dimension n (:func:`window_margin`)."""
-        return window_margin(diagram, n, cover_radius, self.thresholds_[n])
+    def margin(self, diagram: Diagram, cover_radius: float | None, n: int) -> float:
+        """How far the window's own count in dimension n is from changing (:func:`score_margin`)."""
+        th = self.thresholds_[n]
+        return score_margin(window_scores(diagram, n, th.q), th.tau)
 
     # -- a region: several windows --------------------------------------------------------
+    def pooled_betti(self, windows: Sequence[WindowBars]) -> dict[int, int]:
+        """The region's beta_hat_n: pooled scores (``"mean"``) or the lower median of the
+        windows' counts (``"median"``)."""
+        maxdim = windows[0].diagram.maxdim
+        if self.pooling == "median":
+            return {n: median_vote([self.betti(w.diagram)[n] for w in windows])
+                    for n in self.thresholds_ if n <= maxdim}
+        return {n: count_above(pooled_scores([w.diagram for w in windows], n, th.q), th.tau)
+                for n, th in self.thresholds_.items() if n <= maxdim}
+
     def region_features(self, windows: Sequence[WindowBars], n: int, voted=None) -> np.ndarray:
         """(agreement a, margin m, number of windows) of one region for dimension n;
         ``voted`` is :func:`vote`'s result for these windows when the caller has it."""
         betti, rep, counts = voted or vote(self, windows)
         agreement = float(np.mean(np.asarray(counts[n]) == betti[n]))
-        margin = window_margin(windows[rep].diagram, n, windows[rep].cover_radius, self.thresholds_[n])
+        th = self.thresholds_[n]
+        if self.pooling == "median":
+            margin = self.margin(windows[rep].diagram, windows[rep].cover_radius, n)
+        else:
+            margin = score_margin(pooled_scores([w.diagram for w in windows], n, th.q), th.tau)
         return np.array([agreement, margin, float(len(windows))])
 
     def region_confidence(self, windows: Sequence[WindowBars], voted=None) -> dict[int, float | None]:
@@ -299,21 +297,25 @@ class RatioClassifier:
     # -- description and files ------------------------------------------------------------
     def describe(self) -> dict[str, Any]:
         """What map.json says about how its Betti numbers were read."""
+        pooled = ("the number of ranks k whose mean score over the time windows exceeds ln tau, a window's k-th "
+                  "score being ln(l / l_q) of its k-th longest dim-n bar (clipped to [0, ln 1000]; l_q = q-quantile "
+                  "of the window's dim-n bar lengths)" if self.pooling == "mean" else
+                  "the lower median over time windows of the number of dim-n bars longer than tau * l_q "
+                  "(l_q = q-quantile of the window's dim-n bar lengths)")
         return {
             "classifier": self.provenance_.get("name", "custom"),
-            "definition": "beta_n = lower median over time windows of the count of candidate bars of dim n "
-                          "(length > tau * l_q, death/birth > rho, length > kappa * r_cover; l_q = q-quantile of "
-                          "the window's dim-n bar lengths); with gamma >= 1 only the candidates down to the "
-                          "largest log gap between consecutive bar lengths count, if that gap is >= ln gamma",
+            "definition": f"beta_n = {pooled}",
+            "pooling": self.pooling,
             "theta": {str(n): th.to_json() for n, th in self.thresholds_.items()},
             "confidence": "P(correct) from a logistic model of the windows' agreement with the vote, the "
-                          "nearest bar's log margin and the number of windows, fitted on the benchmark's "
+                          "vote's log margin and the number of windows, fitted on the benchmark's "
                           "tuning maps; beta_0: tuning-set rate",
         }
 
     def to_json(self) -> dict[str, Any]:
         return {
             "format": RATIO_FORMAT,
+            "pooling": self.pooling,
             "thresholds": {str(n): th.to_json() for n, th in self.thresholds_.items()},
             "calibration": self.calibration_ or None,
             "provenance": {**self.provenance_, "swarmtopo": self.provenance_.get("swarmtopo", __version__)},
@@ -328,9 +330,19 @@ class RatioClassifier:
     def from_json(cls, obj: dict, source: str = "<json>") -> "RatioClassifier":
         check_format(obj, READ_FORMATS, "swarmtopo ratio classifier", source)
         try:
-            thresholds = {int(n): RatioThresholds(float(t["q"]), float(t["tau"]), float(t["rho"]), float(t["kappa"]),
-                                                  float(t.get("gamma", 0.0)))
-                          for n, t in obj["thresholds"].items()}
-            return cls(thresholds, obj.get("calibration") or None, obj.get("provenance") or {})
+            thresholds = {}
+            for n, t in obj["thresholds"].items():
+                gates = {"rho": float(t.get("rho", 1.0)), "kappa": float(t.get("kappa", 0.0)),
+                         "gamma": float(t.get("gamma", 0.0))}
+                if gates != {"rho": 1.0, "kappa": 0.0, "gamma": 0.0}:
+                    raise InputError("this ratio classifier uses the death/birth, covering-radius or gap tests "
+                                     "of earlier swarmtopo versions, which are no longer applied; refit it "
+                                     "(scripts/tune_accuracy.py)", file=source, column=f"thresholds.{n}",
+                                     value=gates)
+                thresholds[int(n)] = RatioThresholds(float(t["q"]), float(t["tau"]))
+            pooling = obj.get("pooling", "mean") if obj["format"] == RATIO_FORMAT else "median"
+            return cls(thresholds, obj.get("calibration") or None, obj.get("provenance") or {}, pooling)
+        except InputError:
+            raise
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise InputError(f"malformed ratio classifier: {exc!r}", file=source) from None

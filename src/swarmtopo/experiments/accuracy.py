@@ -57,7 +57,7 @@ QUICK_PER_CELL = 10
 SLICE_PER_CELL = 2
 """The regression slice: the first SLICE_PER_CELL reporting cases of every cell
 (default pipeline), rerun by tests/test_accuracy.py against the rate recorded here."""
-TUNING_PER_CELL = 24
+TUNING_PER_CELL = 48
 
 PIPELINES: dict[str, dict[str, Any]] = {
     "default": {"metric": "hybrid", "hop_cost": "auto", "diffusion_time": "auto",
@@ -254,19 +254,23 @@ def accuracy_table(records: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
-def reliability(records: list[dict[str, Any]], n: int, bins: int = 5) -> dict[str, Any]:
-    """Calibration of the beta_n confidence: per confidence bin, the mean confidence
-    and the fraction right; the Brier score against a constant equal to the accuracy."""
+RELIABILITY_EDGES = (0.0, 0.5, 0.7, 0.8, 0.9, 0.95, 0.99, 1.0)
+"""Confidence bins of the reliability table: narrow near 1, where most maps are reported."""
+
+
+def reliability(records: list[dict[str, Any]], n: int, edges: tuple[float, ...] = RELIABILITY_EDGES) -> dict[str, Any]:
+    """Calibration of the beta_n confidence: per confidence bin (``edges``), the mean
+    confidence and the fraction right; the Brier score against a constant equal to the
+    accuracy."""
     pairs = [(r[f"confidence_betti{n}"], r[f"betti{n}_right"]) for r in records
              if r[f"confidence_betti{n}"] is not None]
     if not pairs:
         return {"bins": [], "brier": None, "brier_constant": None, "maps": 0}
     p = np.array([c for c, _ in pairs], dtype=float)
     y = np.array([ok for _, ok in pairs], dtype=float)
-    edges = np.linspace(0.0, 1.0, bins + 1)
-    which = np.clip(np.digitize(p, edges[1:-1]), 0, bins - 1)
+    which = np.clip(np.digitize(p, edges[1:-1]), 0, len(edges) - 2)
     table = []
-    for b in range(bins):
+    for b in range(len(edges) - 1):
         inside = which == b
         if inside.any():
             table.append({"low": float(edges[b]), "high": float(edges[b + 1]), "maps": int(inside.sum()),
@@ -362,7 +366,7 @@ def markdown(summary: dict[str, Any], command: str) -> str:
     if len(in_slice) == SLICE_PER_CELL * len(summary["pipelines"]["default"]["table"]["cells"]):
         lines += ["", f"Regression slice: {sum(r['right'] for r in in_slice)}/{len(in_slice)} exact (the first "
                       f"{SLICE_PER_CELL} reporting cases of every cell, default pipeline; tests/test_accuracy.py "
-                      "reruns them and fails below the 1 % binomial quantile of this rate)."]
+                      "reruns them and fails below the 1 % binomial quantile of this rate, Laplace-smoothed)."]
     for n_dim in ("1", "0"):
         rel = summary["pipelines"]["default"]["reliability"][n_dim]
         if not rel["maps"]:
@@ -373,6 +377,6 @@ def markdown(summary: dict[str, Any], command: str) -> str:
                   "| confidence | maps | mean confidence | fraction right [Wilson 95 %] |", "|---|---|---|---|"]
         for b in rel["bins"]:
             lo, hi = b["wilson95"]
-            lines.append(f"| {b['low']:.1f}-{b['high']:.1f} | {b['maps']} | {b['mean_confidence']:.2f} | "
-                         f"{b['fraction_right']:.2f} [{lo:.2f}, {hi:.2f}] |")
+            lines.append(f"| {b['low']:.2f}-{b['high']:.2f} | {b['maps']} | {b['mean_confidence']:.3f} | "
+                         f"{b['fraction_right']:.3f} [{lo:.2f}, {hi:.2f}] |")
     return "\n".join(lines) + "\n"

@@ -30,10 +30,10 @@ Format (``examples/sweep-small.toml`` is a commented example)::
                               # half the mean time between an agent's encounters) or "none" (the paper)
     wall_follow_weight = 2.0  # s charged per s of wall following in a gap, outside the diffusive
                               # weights: a number >= 0 (default 2) or "none" (like any time, the paper)
-    window_length = "auto"    # windows voted over, s: a number > 0, "auto" (default: window_encounters
+    window_length = "auto"    # windows pooled, s: a number > 0, "auto" (default: window_encounters
                               # encounters per agent) or "none" (whole log, the paper)
     window_encounters = 20.0  # K of automatic windows (only with window_length = "auto")
-    window_scales = [1.0]     # multipliers of the window length whose windows all vote (default [1])
+    window_scales = [0.75, 1.0, 1.25]  # multipliers of the window length whose windows are all pooled
     window_step = "auto"      # s between window starts: a number > 0 or "auto" (half the length)
     subsample = "maxmin"      # maxmin | knn | probabilistic (default maxmin)
     landmarks = "auto"        # an integer L >= 3, or "auto" (default)
