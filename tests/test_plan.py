@@ -13,17 +13,23 @@ from swarmtopo.plan import PlanModel, fit_plan, load_plan
 runner = CliRunner()
 
 
-def synthetic_records(n, rng, c=(-2.0, 1.5, 2.0)):
-    """Maps drawn from P(right) = sigmoid(c0 + c1 ln(N/A) + c2 ln T) with A around 1 m^2."""
+def synthetic_records(n, rng, c=(-2.0, 1.5, 2.0, -0.8)):
+    """Maps drawn from P(right) = sigmoid(c0 + c1 ln(N/A) + c2 ln T + c3 H) with A around
+    1 m^2 and H uniform in 0-3."""
     records = []
     for _ in range(n):
         area = rng.uniform(0.5e6, 1.5e6)
         agents = rng.integers(100, 500)
         duration = rng.uniform(20, 80)
-        z = c[0] + c[1] * np.log(agents / area * 1e4) + c[2] * np.log(duration / 30)
-        records.append({"area": area, "agents": int(agents), "duration": duration,
+        holes = int(rng.integers(0, 4))
+        z = c[0] + c[1] * np.log(agents / area * 1e4) + c[2] * np.log(duration / 30) + c[3] * holes
+        records.append({"area": area, "agents": int(agents), "duration": duration, "true_betti1": holes,
                         "right": bool(rng.random() < 1 / (1 + np.exp(-z)))})
     return records
+
+
+def sigmoid(z):
+    return 1 / (1 + np.exp(-z))
 
 
 def test_fit_recovers_the_law_it_was_drawn_from():
@@ -32,19 +38,51 @@ def test_fit_recovers_the_law_it_was_drawn_from():
     # slope standard errors at n = 4000 are about 0.1; 0.3 is three of them
     assert model.density_coef == pytest.approx(1.5, abs=0.3)
     assert model.duration_coef == pytest.approx(2.0, abs=0.3)
-    p = model.accuracy(1e6, 300, 40)
-    truth = 1 / (1 + np.exp(-(-2.0 + 1.5 * np.log(300 / 1e6 * 1e4) + 2.0 * np.log(40 / 30))))
-    assert p == pytest.approx(truth, abs=0.04)
+    assert model.holes_coef == pytest.approx(-0.8, abs=0.3)
+    assert model.holes_mix == pytest.approx((0.25,) * 4, abs=0.03)  # H uniform in 0-3
+    z = -2.0 + 1.5 * np.log(300 / 1e6 * 1e4) + 2.0 * np.log(40 / 30)
+    assert model.accuracy(1e6, 300, 40, holes=2) == pytest.approx(sigmoid(z - 1.6), abs=0.04)
+    assert model.accuracy(1e6, 300, 40) == pytest.approx(np.mean([sigmoid(z - 0.8 * h) for h in range(4)]), abs=0.04)
+
+
+def test_unknown_holes_average_over_the_mix_and_more_holes_need_more_data():
+    model = PlanModel(-3.0, 1.2, 1.8, (1e-4, 1e-3), (30, 60), 100, "test", -0.5, (0.5, 0.25, 0.25))
+    per_hole = [model.accuracy(250_000, 200, 30, holes=h) for h in range(3)]
+    assert model.accuracy(250_000, 200, 30) == pytest.approx(0.5 * per_hole[0] + 0.25 * (per_hole[1] + per_hole[2]))
+    assert per_hole[0] > per_hole[1] > per_hole[2]
+    assert model.agents_for(250_000, 30, 0.9, holes=2) > model.agents_for(250_000, 30, 0.9, holes=0)
+    assert model.inside(250_000, 100, 40, holes=2) and not model.inside(250_000, 100, 40, holes=3)
+    with pytest.raises(InputError, match="holes"):
+        model.accuracy(250_000, 200, 30, holes=-1)
 
 
 def test_inverse_answers_invert_the_forward_one():
+    for model in (PlanModel(-3.0, 1.2, 1.8, (1e-4, 1e-3), (30, 60), 100, "test"),
+                  PlanModel(-3.0, 1.2, 1.8, (1e-4, 1e-3), (30, 60), 100, "test", -0.7, (0.25,) * 4)):
+        for holes in (None, 0, 3):
+            n = model.agents_for(250_000, 40, 0.9, holes)
+            assert model.accuracy(250_000, n, 40, holes) == pytest.approx(0.9)
+            t = model.duration_for(250_000, 300, 0.95, holes)
+            assert model.accuracy(250_000, 300, t, holes) == pytest.approx(0.95)
+    # without a hole term the answer has a closed form: ln(N / A) = (logit p - c0 - c2 ln T) / c1
     model = PlanModel(-3.0, 1.2, 1.8, (1e-4, 1e-3), (30, 60), 100, "test")
-    n = model.agents_for(250_000, 40, 0.9)
-    assert model.accuracy(250_000, n, 40) == pytest.approx(0.9)
-    t = model.duration_for(250_000, 300, 0.95)
-    assert model.accuracy(250_000, 300, t) == pytest.approx(0.95)
+    closed = 250_000 * np.exp((np.log(0.9 / 0.1) + 3.0 - 1.8 * np.log(40)) / 1.2)
+    assert model.agents_for(250_000, 40, 0.9) == pytest.approx(closed, rel=1e-6)
     flat = PlanModel(0.0, 0.0, -1.0, (1e-4, 1e-3), (30, 60), 100, "test")
     assert flat.agents_for(1, 1, 0.9) == np.inf and flat.duration_for(1, 1, 0.9) == np.inf
+
+
+def test_format_1_files_read_without_a_hole_term_and_bad_mixes_are_refused(tmp_path):
+    old = {"format": "swarmtopo-plan/1", "intercept": -3.0, "density_coef": 1.2, "duration_coef": 1.8,
+           "density_range": [1e-4, 1e-3], "duration_range": [30, 60], "maps": 100, "source": "old"}
+    path = tmp_path / "old.json"
+    path.write_text(json.dumps(old))
+    model = load_plan(path)
+    assert model.holes_coef == 0.0 and model.accuracy(1e6, 300, 40, holes=3) == model.accuracy(1e6, 300, 40)
+    bad = {**model.to_json(), "holes_mix": [0.5, 0.2]}
+    path.write_text(json.dumps(bad))
+    with pytest.raises(InputError, match="holes_mix"):
+        load_plan(path)
 
 
 def test_bad_plan_inputs():
@@ -54,12 +92,12 @@ def test_bad_plan_inputs():
     with pytest.raises(InputError, match="area"):
         model.accuracy(-1, 200, 30)
     with pytest.raises(SwarmtopoError, match="both right and wrong"):
-        fit_plan([{"area": 1.0, "agents": 1, "duration": 1.0, "right": True}] * 3, source="x")
+        fit_plan([{"area": 1.0, "agents": 1, "duration": 1.0, "true_betti1": 0, "right": True}] * 3, source="x")
 
 
 def test_plan_cli_forward_and_inverse(tmp_path):
     path = tmp_path / "plan.json"
-    model = PlanModel(-3.0, 1.2, 1.8, (5e-4, 2e-3), (30, 60), 100, "test")
+    model = PlanModel(-3.0, 1.2, 1.8, (5e-4, 2e-3), (30, 60), 100, "test", -0.6, (0.25,) * 4)
     path.write_text(json.dumps(model.to_json()))
     res = runner.invoke(app, ["plan", "--area", "250000", "--agents", "200", "--duration", "30", "--model", str(path)])
     assert res.exit_code == 0, res.output
@@ -68,6 +106,13 @@ def test_plan_cli_forward_and_inverse(tmp_path):
     assert res.exit_code == 0 and f"needed: {int(np.ceil(model.agents_for(250000, 30, 0.95)))} agents" in res.output
     res = runner.invoke(app, ["plan", "--area", "250000", "--agents", "200", "--model", str(path)])
     assert res.exit_code != 0 and "two of --agents, --duration and --target" in res.output
+    res = runner.invoke(app, ["plan", "--area", "250000", "--agents", "200", "--duration", "30", "--holes", "3",
+                              "--model", str(path)])
+    assert res.exit_code == 0 and f"{100 * model.accuracy(250000, 200, 30, 3):.0f}%" in res.output
+    assert "with 3 holes" in res.output
+    res = runner.invoke(app, ["plan", "--area", "250000", "--agents", "200", "--duration", "30", "--holes", "-1",
+                              "--model", str(path)])
+    assert res.exit_code != 0
 
 
 def test_shipped_plan_was_fitted_on_the_full_benchmark():
@@ -79,3 +124,4 @@ def test_shipped_plan_was_fitted_on_the_full_benchmark():
     hi = max(n for n, _ in BUDGETS) / (500 * SCALE_RANGE[0]) ** 2
     assert lo * 0.99 <= model.density_range[0] and model.density_range[1] <= hi * 1.01
     assert model.duration_range == (min(t for _, t in BUDGETS), max(t for _, t in BUDGETS))
+    assert len(model.holes_mix) == 4 and model.holes_coef < 0  # 0-3 holes; more holes, harder

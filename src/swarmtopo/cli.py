@@ -477,19 +477,22 @@ def bench_accuracy(
 
 
 @app.command(epilog="Examples: swarmtopo plan --area 250000 --agents 200 --duration 30;  "
-                    "swarmtopo plan --area 250000 --agents 200 --target 0.95")
+                    "swarmtopo plan --area 250000 --agents 200 --target 0.95 --holes 3")
 def plan(
     area: float = typer.Option(..., "--area", help="Area inside the outer walls, mm^2."),
     agents: Optional[int] = typer.Option(None, "--agents", min=1, help="Swarm size N."),
     duration: Optional[float] = typer.Option(None, "--duration", help="Seconds of data T."),
     target: Optional[float] = typer.Option(None, "--target", help="Wanted exact-match accuracy, e.g. 0.95."),
+    holes: Optional[int] = typer.Option(None, "--holes", min=0, help="Holes the arena is expected to have "
+                                        "(default: averaged over the benchmark's mix of 0-3 holes)."),
     model_file: Optional[Path] = typer.Option(None, "--model", help="plan.json of a benchmark run "
                                                                     "(default: the shipped one)."),
 ) -> None:
     """What accuracy a deployment will get, or the agents / time it needs for a target.
 
     Give --agents and --duration for the expected accuracy; or one of them and --target
-    for the other.  Answers come from the accuracy benchmark (docs/accuracy.md).
+    for the other; --holes if you know how many holes to expect.  Answers come from the
+    accuracy benchmark (docs/accuracy.md).
     """
     from .plan import load_plan
 
@@ -497,26 +500,29 @@ def plan(
     if sum(given.values()) != 2:
         raise typer.BadParameter("give two of --agents, --duration and --target (the third is computed)")
     model = load_plan(model_file)
+    with_holes = "" if holes is None else f" with {holes} hole{'' if holes == 1 else 's'}"
     if target is None:
-        p = model.accuracy(area, agents, duration)
+        p = model.accuracy(area, agents, duration, holes)
         out.print(f"expected exact (beta_0, beta_1) accuracy: {100 * p:.0f}% "
-                  f"({agents} agents x {duration:g} s in {area:g} mm^2)", markup=False, highlight=False)
+                  f"({agents} agents x {duration:g} s in {area:g} mm^2{with_holes})", markup=False, highlight=False)
         n, t = agents, duration
     elif agents is None:
-        n = model.agents_for(area, duration, target)
+        n = model.agents_for(area, duration, target, holes)
         t = duration
-        out.print(_plan_answer("agents", n, f"for {100 * target:g}% in {duration:g} s over {area:g} mm^2"),
+        out.print(_plan_answer("agents", n, f"for {100 * target:g}% in {duration:g} s over {area:g} mm^2{with_holes}"),
                   markup=False, highlight=False)
     else:
-        t = model.duration_for(area, agents, target)
+        t = model.duration_for(area, agents, target, holes)
         n = agents
-        out.print(_plan_answer("seconds of data", t, f"for {100 * target:g}% with {agents} agents over {area:g} mm^2"),
+        out.print(_plan_answer("seconds of data", t,
+                               f"for {100 * target:g}% with {agents} agents over {area:g} mm^2{with_holes}"),
                   markup=False, highlight=False)
-    if np.isfinite(n) and np.isfinite(t) and not model.inside(area, n, t):
+    if np.isfinite(n) and np.isfinite(t) and not model.inside(area, n, t, holes):
         lo, hi = model.density_range
         t_lo, t_hi = model.duration_range
         out.print(f"note: outside the benchmark's range ({lo * 1e6:.0f}-{hi * 1e6:.0f} agents per m^2, "
-                  f"{t_lo:g}-{t_hi:g} s): an extrapolation", markup=False, highlight=False)
+                  f"{t_lo:g}-{t_hi:g} s, 0-{len(model.holes_mix) - 1} holes): an extrapolation",
+                  markup=False, highlight=False)
 
 
 def _plan_answer(what: str, value: float, condition: str) -> str:

@@ -2,16 +2,19 @@
 
 The model is fitted by ``swarmtopo bench accuracy`` on its reporting maps of the
 default pipeline and shipped as ``swarmtopo/data/plan.json``: a logistic regression of
-"(beta_0, beta_1) exactly right" on ln(agent density N / A) and ln(duration T),
+"(beta_0, beta_1) exactly right" on ln(agent density N / A), ln(duration T) and the
+number of holes H,
 
-    P(right | A, N, T) = sigmoid(c0 + c1 ln(N / A) + c2 ln T)
+    P(right | A, N, T, H) = sigmoid(c0 + c1 ln(N / A) + c2 ln T + c3 H)
 
 (A in mm^2 inside the outer walls, N agents, T seconds).  Arena size enters only
 through the density: the suite varies the scale of every case, so maps of the same
-swarm size in bigger arenas are sparser.  The inverse questions solve the same
-equation for N or T.  The benchmark spans a range of densities and durations
-(``PlanModel.density_range``, ``duration_range``); answers outside it are
-extrapolations and say so.
+swarm size in bigger arenas are sparser.  A team that does not know H gets the
+average over the benchmark's mix of hole counts (``PlanModel.holes_mix``).  The
+inverse questions solve the same equation for N or T.  The benchmark spans a range
+of densities, durations and hole counts (``density_range``, ``duration_range``,
+``len(holes_mix) - 1``); answers outside it are extrapolations and say so.
+Format /1 files (no hole term) are read with c3 = 0.
 """
 
 from __future__ import annotations
@@ -23,18 +26,22 @@ from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
-from scipy.special import expit, logit
+from scipy.optimize import brentq
+from scipy.special import expit
 from sklearn.linear_model import LogisticRegression
 
 from ._validate import check_format, positive
 from .errors import InputError, SwarmtopoError
 
-PLAN_FORMAT = "swarmtopo-plan/1"
+PLAN_FORMAT = "swarmtopo-plan/2"
+READ_FORMATS = ("swarmtopo-plan/1", PLAN_FORMAT)
+LOG_SPAN = 50.0
+"""How far (in ln units) beyond the benchmark's range the inverse answers search."""
 
 
 @dataclass(frozen=True)
 class PlanModel:
-    """P(right) = sigmoid(intercept + density_coef ln(N/A) + duration_coef ln T)."""
+    """P(right) = sigmoid(intercept + density_coef ln(N/A) + duration_coef ln T + holes_coef H)."""
 
     intercept: float
     density_coef: float
@@ -43,64 +50,94 @@ class PlanModel:
     duration_range: tuple[float, float]  # seconds
     maps: int
     source: str
+    holes_coef: float = 0.0
+    holes_mix: tuple[float, ...] = (1.0,)  # fraction of the benchmark's maps with 0, 1, 2, ... holes
 
-    def accuracy(self, area: float, agents: float, duration: float) -> float:
-        """Expected exact-match accuracy of the default pipeline."""
+    def accuracy(self, area: float, agents: float, duration: float, holes: int | None = None) -> float:
+        """Expected exact-match accuracy of the default pipeline with ``holes`` holes
+        (None: averaged over the benchmark's mix of hole counts)."""
         _check_positive(area=area, agents=agents, duration=duration)
-        return float(expit(self.intercept + self.density_coef * np.log(agents / area)
-                           + self.duration_coef * np.log(duration)))
+        return self._accuracy(np.log(agents / area), np.log(duration), holes)
 
-    def agents_for(self, area: float, duration: float, target: float) -> float:
+    def agents_for(self, area: float, duration: float, target: float, holes: int | None = None) -> float:
         """Agents N needed for ``target`` accuracy (inf if more agents do not help)."""
         _check_positive(area=area, duration=duration)
-        if self.density_coef <= 0:
-            return float("inf")
-        log_density = (logit(_target(target)) - self.intercept - self.duration_coef * np.log(duration)) / self.density_coef
+        log_t = np.log(duration)
+        log_density = self._solve(lambda x: self._accuracy(x, log_t, holes), self.density_coef,
+                                  np.log(self.density_range), target)
         return float(area * np.exp(log_density))
 
-    def duration_for(self, area: float, agents: float, target: float) -> float:
+    def duration_for(self, area: float, agents: float, target: float, holes: int | None = None) -> float:
         """Seconds T needed for ``target`` accuracy (inf if more time does not help)."""
         _check_positive(area=area, agents=agents)
-        if self.duration_coef <= 0:
-            return float("inf")
-        log_t = (logit(_target(target)) - self.intercept - self.density_coef * np.log(agents / area)) / self.duration_coef
+        log_density = np.log(agents / area)
+        log_t = self._solve(lambda x: self._accuracy(log_density, x, holes), self.duration_coef,
+                            np.log(self.duration_range), target)
         return float(np.exp(log_t))
 
-    def inside(self, area: float, agents: float, duration: float) -> bool:
-        """Whether (N / A, T) lies in the range the benchmark measured."""
+    def inside(self, area: float, agents: float, duration: float, holes: int | None = None) -> bool:
+        """Whether (N / A, T, H) lies in the range the benchmark measured."""
         density = agents / area
         return (self.density_range[0] <= density <= self.density_range[1]
-                and self.duration_range[0] <= duration <= self.duration_range[1])
+                and self.duration_range[0] <= duration <= self.duration_range[1]
+                and (holes is None or holes < len(self.holes_mix)))
+
+    def _accuracy(self, log_density: float, log_duration: float, holes: int | None) -> float:
+        base = self.intercept + self.density_coef * log_density + self.duration_coef * log_duration
+        if holes is not None:
+            if holes < 0:
+                raise InputError("the number of holes must be >= 0", column="holes", value=holes)
+            return float(expit(base + self.holes_coef * holes))
+        return float(sum(w * expit(base + self.holes_coef * h) for h, w in enumerate(self.holes_mix)))
+
+    @staticmethod
+    def _solve(accuracy_at, coef: float, log_range, target: float) -> float:
+        """The ln x where ``accuracy_at(ln x)`` (increasing when ``coef`` > 0) equals ``target``."""
+        target = _target(target)
+        if coef <= 0:
+            return float("inf")
+        lo, hi = log_range[0] - LOG_SPAN, log_range[1] + LOG_SPAN
+        if not accuracy_at(lo) < target < accuracy_at(hi):
+            return float("inf") if accuracy_at(hi) <= target else float("-inf")
+        return float(brentq(lambda x: accuracy_at(x) - target, lo, hi, xtol=1e-10))
 
     def to_json(self) -> dict[str, Any]:
         return {"format": PLAN_FORMAT, "intercept": self.intercept, "density_coef": self.density_coef,
-                "duration_coef": self.duration_coef, "density_range": list(self.density_range),
+                "duration_coef": self.duration_coef, "holes_coef": self.holes_coef,
+                "holes_mix": list(self.holes_mix), "density_range": list(self.density_range),
                 "duration_range": list(self.duration_range), "maps": self.maps, "source": self.source}
 
     @classmethod
     def from_json(cls, obj: dict, source: str = "<json>") -> "PlanModel":
-        check_format(obj, PLAN_FORMAT, "swarmtopo plan model", source)
+        check_format(obj, READ_FORMATS, "swarmtopo plan model", source)
         try:
-            return cls(float(obj["intercept"]), float(obj["density_coef"]), float(obj["duration_coef"]),
-                       tuple(map(float, obj["density_range"])), tuple(map(float, obj["duration_range"])),
-                       int(obj["maps"]), str(obj["source"]))
+            model = cls(float(obj["intercept"]), float(obj["density_coef"]), float(obj["duration_coef"]),
+                        tuple(map(float, obj["density_range"])), tuple(map(float, obj["duration_range"])),
+                        int(obj["maps"]), str(obj["source"]), float(obj.get("holes_coef", 0.0)),
+                        tuple(map(float, obj.get("holes_mix", (1.0,)))))
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"malformed plan model: {exc!r}", file=source) from None
+        if not model.holes_mix or abs(sum(model.holes_mix) - 1.0) > 1e-6 or min(model.holes_mix) < 0:
+            raise InputError("holes_mix must be fractions summing to 1", file=source, column="holes_mix",
+                             value=list(model.holes_mix))
+        return model
 
 
 def fit_plan(records: Sequence[dict[str, Any]], source: str) -> PlanModel:
     """The plan model of the benchmark's reporting records (``area``, ``agents``,
-    ``duration``, ``right``), by a lightly regularised logistic regression."""
+    ``duration``, ``true_betti1``, ``right``), by a lightly regularised logistic regression."""
     density = np.array([r["agents"] / r["area"] for r in records], dtype=float)
     duration = np.array([r["duration"] for r in records], dtype=float)
+    holes = np.array([r["true_betti1"] for r in records], dtype=int)
     right = np.array([r["right"] for r in records], dtype=bool)
     if len(np.unique(right)) < 2:
         raise SwarmtopoError("the plan needs both right and wrong maps to fit (every map had the same outcome)")
-    X = np.column_stack([np.log(density), np.log(duration)])
+    X = np.column_stack([np.log(density), np.log(duration), holes])
     model = LogisticRegression(C=10.0).fit(X, right)
+    mix = np.bincount(holes) / len(holes)
     return PlanModel(float(model.intercept_[0]), float(model.coef_[0, 0]), float(model.coef_[0, 1]),
                      (float(density.min()), float(density.max())), (float(duration.min()), float(duration.max())),
-                     int(len(right)), source)
+                     int(len(right)), source, float(model.coef_[0, 2]), tuple(float(w) for w in mix))
 
 
 def load_plan(path: str | Path | None = None) -> PlanModel:
