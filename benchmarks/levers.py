@@ -17,8 +17,9 @@ diffusion time, wall following x 2):
 * ``20s`` -- fixed 20 s windows overlapping by half (the previous default).
 * ``whole`` -- the whole log at once.
 * ``quarter`` -- automatic windows started every quarter window (twice the windows).
-* ``draws`` -- three landmark draws (seeds) per window, all their counts voted;
-  ``draws-K`` K draws.  The map's seed is the case's; draw d uses seed + d.
+* ``draws`` -- three landmark draws (seeds) per window, all their windows pooled;
+  ``draws-K`` K draws, ``draws-K/VARIANT`` K draws of another variant (e.g.
+  ``draws-3/max_landmarks=250``).  The map's seed is the case's; draw d uses seed + d.
 * ``seed+D`` -- the default with the landmark draw of seed + D: one of ``draws-K``'s
   draws on its own (``default`` is draw 0), to measure the spread a draw causes;
   ``VARIANT@D`` is any variant with the landmark draw of seed + D.
@@ -117,10 +118,11 @@ def _quarter(log, seed):
     return _windows_of(log, seed, window_step=length / 4 if np.isfinite(length) else None)
 
 
-def _draws(log, seed, k=3):
-    regions, beta0 = _windows_of(log, seed)
+def _draws(log, seed, k=3, mapper=None):
+    mapper = mapper or _windows_of
+    regions, beta0 = mapper(log, seed)
     for d in range(1, k):
-        more, _ = _windows_of(log, seed + d)
+        more, _ = mapper(log, seed + d)
         regions = [a + b for a, b in zip(regions, more)]
     return regions, beta0
 
@@ -394,10 +396,11 @@ def _variant(name):
     if "@" in name:
         base, offset = name.rsplit("@", 1)
         return lambda log, seed: _variant(base)(log, seed + int(offset))
+    if name.startswith("draws-"):
+        k, _, inner = name.split("-", 1)[1].partition("/")
+        return lambda log, seed: _draws(log, seed, int(k), _variant(inner) if inner else None)
     if "=" in name:
         return _override(name)
-    if name.startswith("draws-"):
-        return lambda log, seed: _draws(log, seed, int(name.split("-", 1)[1]))
     if name.startswith("seed+"):
         return lambda log, seed: _windows_of(log, seed + int(name.split("+", 1)[1]))
     if name.startswith("wall-"):
@@ -481,7 +484,8 @@ def main() -> None:
     parser.add_argument("--per-cell", type=int, default=12)
     parser.add_argument("--variants", nargs="+", default=["default", "20s", "whole", "quarter", "draws", "switch"],
                         help=f"{', '.join(sorted(VARIANTS))}, diffusive-C, switch-C, log-C, wall-C, wall-none, "
-                             "smooth-HOW-K, paths-C, dtm-K, mds-D, mix-K1-K2[-whole], draws-K, seed+D, tcorr-S or FIELD=VALUE; "
+                             "smooth-HOW-K, paths-C, dtm-K, mds-D, mix-K1-K2[-whole], draws-K[/VARIANT], seed+D, tcorr-S or "
+                             "FIELD=VALUE; "
                              "VARIANT@D: with the landmark draw of seed + D")
     parser.add_argument("--cells", nargs="+", metavar="TEXT",
                         help="only the cells whose name contains one of these (default: all)")
