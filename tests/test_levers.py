@@ -42,3 +42,14 @@ def test_dtm_filtration_of_a_square_by_hand():
     # equal weights: vertices enter at c, an edge of length d at c + d / 2
     np.testing.assert_allclose(diagram[0][np.isfinite(diagram[0][:, 1])], [[c, c + side / 2]] * 3)
     np.testing.assert_allclose(diagram[1], [[c + side / 2, c + diagonal / 2]])
+
+
+def test_draws_of_a_variant_pool_that_variants_windows_at_consecutive_seeds():
+    """``draws-K/VARIANT@D``: VARIANT mapped with seeds s + D, ..., s + D + K - 1, windows concatenated."""
+    log = simulate(random_arena(1, rng=3), 60, 10.0, rng=3).log
+    regions, beta0 = levers._variant("draws-2/max_landmarks=40@1")(log, 5)
+    parts = [levers._windows_of(log, seed, max_landmarks=40) for seed in (6, 7)]
+    assert beta0 == parts[0][1]
+    expected = [a + b for a, b in zip(parts[0][0], parts[1][0])]
+    assert [[w.diagram.lengths(1).tolist() for w in r] for r in regions] == \
+        [[w.diagram.lengths(1).tolist() for w in r] for r in expected]
