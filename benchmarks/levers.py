@@ -99,16 +99,16 @@ from swarmtopo.errors import SwarmtopoError
 from swarmtopo.experiments.accuracy import CELLS, case, tuning_session
 from swarmtopo.experiments.grid import case_streams
 from swarmtopo.experiments.sweep import build_arena, stripped_log
-from swarmtopo.experiments.tuning import TuningMap, exact, fit_thresholds
+from swarmtopo.experiments.tuning import TuningMap, cross_validated, exact, fit_thresholds
 from swarmtopo.persistence import Diagram, rips_persistence
 from swarmtopo.pipeline import WHOLE_LOG, MapConfig, map_encounters, mean_agent_gap, resolve_window
-from swarmtopo.ratio import POOLINGS, WindowBars
+from swarmtopo.ratio import POOLINGS
 from swarmtopo.sim import simulate
 
 
 def _windows_of(log, seed, **options):
     tmap = map_encounters(log, MapConfig(seed=seed, embed_dim=0, cycles=False, **options))
-    return [[WindowBars(w.diagram, w.scales.cover_radius) for w in r.windows] for r in tmap.regions], tmap.betti[0]
+    return [[w.diagram for w in r.windows] for r in tmap.regions], tmap.betti[0]
 
 
 def _quarter(log, seed):
@@ -506,11 +506,7 @@ def main() -> None:
         for pooling in POOLINGS:
             fit = fit_thresholds(maps, pooling)
             right = exact(maps, fit.thresholds, pooling)
-            fold = np.arange(len(maps)) % 4
-            cv = sum(int(exact([m for m, f in zip(maps, fold) if f == k],
-                               fit_thresholds([m for m, f in zip(maps, fold) if f != k], pooling).thresholds,
-                               pooling).sum())
-                     for k in range(4))
+            cv = cross_validated(maps, pooling)
             per_cell = [int(sum(ok for m, ok in zip(maps, right) if m.cell == CELLS[c].name)) for c in cells]
             per_family = ", ".join(f"{f} {sum(ok for g, ok in zip(family_of, right) if g == f)}/{family_of.count(f)}"
                                    for f in sorted(set(family_of)))

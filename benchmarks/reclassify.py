@@ -10,7 +10,11 @@ confidence.  Reading a
 store made by an older swarmtopo (other grid columns) works too: only the columns the
 verdict needs are read, so two rounds' maps can be compared under one classifier.
 
-    python benchmarks/reclassify.py --store bench.duckdb [--classifier default old.json ...]
+    python benchmarks/reclassify.py --store bench.duckdb [--classifier default old.json ratio:median:0.7:4.08 ...]
+
+A classifier is a preset, a JSON file, or ``ratio:POOLING:Q:TAU``: the ratio classifier
+with thresholds (q_1, tau_1) pooled by POOLING (mean or median), uncalibrated (no
+Brier score).
 
 Example: the previous round's classifier on this round's maps:
 
@@ -23,6 +27,7 @@ from __future__ import annotations
 import argparse
 
 from swarmtopo.classify import load_classifier
+from swarmtopo.ratio import RatioClassifier, RatioThresholds
 from swarmtopo.experiments.accuracy import CELLS, PIPELINES, accuracy_table, outcomes, reliability
 from swarmtopo.experiments.store import read_jobs
 
@@ -45,13 +50,21 @@ def main() -> None:
     rows = default_rows(args.store)
     print(f"{args.store}: {len(rows)} default-pipeline maps")
     for name in args.classifier:
-        records = outcomes(rows, load_classifier(name))
+        records = outcomes(rows, _classifier(name))
         table, rel = accuracy_table(records), reliability(records, 1)
         cells = ", ".join(f"{table['cells'][c.name].right}" for c in CELLS)
         print(f"{name}: {table['overall'].right}/{table['overall'].total} exact; per cell [{cells}]; "
               f"held-out family {table['held_out'].right}/{table['held_out'].total}; "
-              f"Brier {rel['brier']:.4f} (constant {rel['brier_constant']:.4f})")
+              + (f"Brier {rel['brier']:.4f} (constant {rel['brier_constant']:.4f})" if rel["maps"] else "uncalibrated"))
         print("  " + _misses(records))
+
+
+def _classifier(name: str):
+    """A preset or JSON file (``load_classifier``), or ``ratio:POOLING:Q:TAU``."""
+    if name.startswith("ratio:"):
+        _, pooling, q, tau = name.split(":")
+        return RatioClassifier({1: RatioThresholds(float(q), float(tau))}, pooling=pooling)
+    return load_classifier(name)
 
 
 def _group(record: dict) -> str:

@@ -37,7 +37,8 @@ from swarmtopo import __version__
 from swarmtopo.experiments.accuracy import CELLS, HELD_OUT_FAMILY, SUITE, TUNING_PER_CELL, cell_of, tuning_jobs, tuning_session
 from swarmtopo.experiments.store import read_jobs
 from swarmtopo.experiments.sweep import job_map_config, run_sweep
-from swarmtopo.experiments.tuning import Q_GRID, TAU_GRID, calibrated_classifier, exact, fit_thresholds, maps_from_rows
+from swarmtopo.experiments.tuning import (Q_GRID, TAU_GRID, calibrated_classifier, cross_validated, exact, fit_thresholds,
+                                         maps_from_rows)
 from swarmtopo.pipeline import MapConfig
 from swarmtopo.ratio import POOLINGS
 
@@ -100,10 +101,7 @@ def main() -> None:
             for pooling in POOLINGS:
                 fit = fit_thresholds(maps, pooling)
                 right = exact(maps, fit.thresholds, pooling)
-                fold = np.arange(len(maps)) % CV_FOLDS
-                cv = sum(int(exact([m for m, f in zip(maps, fold) if f == k],
-                                   fit_thresholds([m for m, f in zip(maps, fold) if f != k], pooling).thresholds,
-                                   pooling).sum()) for k in range(CV_FOLDS))
+                cv = cross_validated(maps, pooling, CV_FOLDS)
                 per_cell = {c.name: _rate([ok for m, ok in zip(maps, right) if m.cell == c.name]) for c in CELLS}
                 results[(name, pooling)] = {
                     "fit": fit, "maps": maps, "right": int(right.sum()), "cv": cv, "total": len(candidate_rows),

@@ -51,5 +51,5 @@ def test_draws_of_a_variant_pool_that_variants_windows_at_consecutive_seeds():
     parts = [levers._windows_of(log, seed, max_landmarks=40) for seed in (6, 7)]
     assert beta0 == parts[0][1]
     expected = [a + b for a, b in zip(parts[0][0], parts[1][0])]
-    assert [[w.diagram.lengths(1).tolist() for w in r] for r in regions] == \
-        [[w.diagram.lengths(1).tolist() for w in r] for r in expected]
+    assert [[d.lengths(1).tolist() for d in r] for r in regions] == \
+        [[d.lengths(1).tolist() for d in r] for r in expected]

@@ -12,7 +12,7 @@ from swarmtopo.log import EncounterLog
 from swarmtopo.pipeline import (DIFFUSION_GAP_FACTOR, HOP_GAP_FACTOR, WHOLE_LOG, MapConfig, _share_landmarks,
                                 _scaled_windows, _windows, map_encounters, mean_agent_gap, resolve_diffusion_time, resolve_hop_cost,
                                 resolve_window)
-from swarmtopo.ratio import WindowBars, longest_bars
+from swarmtopo.ratio import longest_bars
 from swarmtopo.sim import simulate
 
 FAST = dict(embed_dim=0)
@@ -206,7 +206,7 @@ def test_window_scales_pool_the_windows_of_every_scale():
     spans = [(w.t0, w.t1) for w in mixed.regions[0].windows]
     assert spans == [(w.t0, w.t1) for m in single for w in m.regions[0].windows]  # every scale's windows, once
     assert len({round(t1 - t0, 9) for t0, t1 in spans}) == 3
-    bars = [WindowBars(w.diagram, w.scales.cover_radius) for w in mixed.regions[0].windows]
+    bars = [w.diagram for w in mixed.regions[0].windows]
     assert mixed.betti[1] == load_classifier("default").pooled_betti(bars)[1]  # one pooling over them all
     assert mixed.window_length == single[1].window_length  # the scale-1 length is the one reported
     assert mixed.to_json()["params"]["window_scales"] == [0.75, 1.0, 1.5]
@@ -272,7 +272,7 @@ def test_windowed_map_pools_and_records_its_windows():
     region = tmap.regions[0]
     assert len(region.windows) == 4  # span ~30 s, 12 s windows every <= 6 s
     classifier = load_classifier("default")
-    bars = [WindowBars(w.diagram, w.scales.cover_radius) for w in region.windows]
+    bars = [w.diagram for w in region.windows]
     assert region.betti[1] == classifier.pooled_betti(bars)[1]  # the classifier's pooling of the windows
     assert [w.betti[1] for w in region.windows] == [classifier.betti(w.diagram)[1] for w in region.windows]
     counts = [w.betti[1] for w in region.windows]

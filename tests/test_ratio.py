@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 from swarmtopo.classify import load_classifier
 from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.persistence import Diagram
-from swarmtopo.ratio import (LOG_RATIO_CAP, MAX_MARGIN, RatioClassifier, RatioThresholds, WindowBars, longest_bars,
+from swarmtopo.ratio import (LOG_RATIO_CAP, MAX_MARGIN, RatioClassifier, RatioThresholds, longest_bars,
                              median_vote, pooled_scores, score_margin, vote, window_scores)
 
 TH = RatioThresholds(q=0.5, tau=2.0)
@@ -19,7 +19,7 @@ def diagram(h1):
 
 
 def windows_of(*h1s):
-    return [WindowBars(diagram(h1), 1.0) for h1 in h1s]
+    return [diagram(h1) for h1 in h1s]
 
 
 def test_window_scores_hand_computed():
@@ -37,8 +37,8 @@ def test_window_count_threshold_and_margin_hand_computed():
     assert model.betti(d) == {1: 1}
     assert model.length_thresholds(d) == {1: pytest.approx(3.0)}
     # [1, 5] is ln(4/3) above the threshold, [2, 3.5] (score 0) ln 2 below: the margin is ln(4/3)
-    assert model.margin(d, None, 1) == pytest.approx(np.log(4 / 3))
-    assert model.margin(diagram(np.empty((0, 2))), None, 1) == MAX_MARGIN
+    assert model.margin(d, 1) == pytest.approx(np.log(4 / 3))
+    assert model.margin(diagram(np.empty((0, 2))), 1) == MAX_MARGIN
     # the infinite bar always counts (tau < 1000)
     assert model.betti(diagram([[1, 5], [2, 3.5], [0.5, 1.5], [1, np.inf]])) == {1: 2}
 
@@ -48,7 +48,7 @@ def test_mean_pooling_hand_computed_against_the_median():
     # window 2: lengths 3, 2, 1 (median 2)    -> scores ln 1.5, 0, 0; own count 0 (3 <= 4)
     # pooled: S_1 = (ln 4 + ln 1.5) / 2 = ln(sqrt 6) > ln 2 -> 1 hole; the lower median of (1, 0) is 0
     w = windows_of([[0, 8], [0, 2], [1, 3], [0, 1]], [[0, 3], [1, 3], [0, 1]])
-    assert pooled_scores([x.diagram for x in w], 1, 0.5) == pytest.approx([np.log(np.sqrt(6)), 0, 0, 0])
+    assert pooled_scores(w, 1, 0.5) == pytest.approx([np.log(np.sqrt(6)), 0, 0, 0])
     mean, median = RatioClassifier({1: TH}), RatioClassifier({1: TH}, pooling="median")
     assert mean.pooled_betti(w) == {1: 1} and median.pooled_betti(w) == {1: 0}
     betti, rep, counts = vote(mean, w)

@@ -1,12 +1,14 @@
 """Tuning the ratio classifier: the grid fit finds a separating threshold and agrees with
 the literal classifier at every grid point; cross-fitted calibration."""
 
+import dataclasses
+
 import numpy as np
 
-from swarmtopo.experiments.tuning import (Q_GRID, TAU_GRID, TuningMap, calibrated_classifier, exact,
+from swarmtopo.experiments.tuning import (Q_GRID, TAU_GRID, TuningMap, calibrated_classifier, cross_validated, exact,
                                          fit_thresholds, grid_estimates)
 from swarmtopo.persistence import Diagram
-from swarmtopo.ratio import RatioThresholds, WindowBars
+from swarmtopo.ratio import RatioThresholds
 
 
 def window(holes, rng):
@@ -14,7 +16,7 @@ def window(holes, rng):
     noise = [[b, b + rng.uniform(0.5, 1.5)] for b in rng.uniform(1, 2, 10)]
     signal = [[b, b + rng.uniform(8, 12)] for b in rng.uniform(1, 2, holes)]
     pairs = np.array(noise + signal, dtype=float).reshape(-1, 2)
-    return WindowBars(Diagram(pairs=(np.array([[0.0, np.inf]]), pairs), backend="test"), 1.0)
+    return Diagram(pairs=(np.array([[0.0, np.inf]]), pairs), backend="test")
 
 
 def synthetic_maps(n, rng):
@@ -45,8 +47,8 @@ def test_vectorised_grid_equals_the_literal_classifier():
     rng = np.random.default_rng(3)
     maps = synthetic_maps(12, rng)
     tie = np.array([[1.0, 3.0], [2.0, 4.0], [0.5, 2.5], [1.0, 1.5], [1.0, np.inf]])
-    odd = (WindowBars(Diagram(pairs=(np.array([[0.0, np.inf]]), tie), backend="test"), 1.0),
-           WindowBars(Diagram(pairs=(np.array([[0.0, np.inf]]), np.empty((0, 2))), backend="test"), 1.0))
+    odd = (Diagram(pairs=(np.array([[0.0, np.inf]]), tie), backend="test"),
+           Diagram(pairs=(np.array([[0.0, np.inf]]), np.empty((0, 2))), backend="test"))
     maps.append(TuningMap(regions=(odd, maps[0].regions[0]), est_betti0=2, true_betti0=2, true_betti1=2, cell="c"))
     truth = np.array([m.true_betti1 for m in maps])
     for pooling in ("mean", "median"):
@@ -65,3 +67,15 @@ def test_cross_fitted_calibration_is_confident_on_clean_maps():
     confidence = model.region_confidence(maps[0].regions[0])[1]
     assert np.isclose(confidence, 31 / 32)
     assert np.isclose(model.beta0_confidence(), 31 / 32)
+
+
+def test_cross_validated_count_reads_every_map_once_with_out_of_fold_thresholds():
+    rng = np.random.default_rng(2)
+    one = TuningMap(regions=(tuple(window(2, rng) for _ in range(3)),), est_betti0=1, true_betti0=1, true_betti1=2,
+                    cell="c")
+    maps = [one] * 20  # every fold fits the same thresholds, and they read every map right
+    for pooling in ("mean", "median"):
+        assert cross_validated(maps, pooling) == 20
+    wrong = maps[:5] + [dataclasses.replace(one, est_betti0=2)] + maps[6:]  # a beta_0 no threshold fixes
+    assert cross_validated(wrong, "mean", folds=5) == 19
+    assert cross_validated(wrong, "mean", folds=4) == 19  # counted once, whatever the folds

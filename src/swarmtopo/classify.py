@@ -233,9 +233,8 @@ class BettiClassifier(BaseEstimator):
         out = out.reshape(len(X), len(self.theta_))
         return out[:, 0] if len(self.theta_) == 1 else out
 
-    def betti(self, diagram: Diagram, cover_radius: float | None = None) -> dict[int, int]:
-        """beta_hat_n of one diagram, for n in dims up to the diagram's maxdim
-        (``cover_radius`` is not used: the paper's form reads bar lengths only)."""
+    def betti(self, diagram: Diagram) -> dict[int, int]:
+        """beta_hat_n of one diagram, for n in dims up to the diagram's maxdim."""
         self._check_fitted()
         return {n: betti_function(bar_lengths(diagram, n), th.q, th.delta, th.tau)
                 for n, th in self.theta_.items() if n <= diagram.maxdim}
@@ -246,22 +245,29 @@ class BettiClassifier(BaseEstimator):
         return {n: th.tau * quantile_scale(bar_lengths(diagram, n), th.q, th.delta)
                 for n, th in self.theta_.items() if n <= diagram.maxdim}
 
-    def margin(self, diagram: Diagram, cover_radius: float | None, n: int) -> float:
+    def margin(self, diagram: Diagram, n: int) -> float:
         """The log-ratio margin m of the bar nearest the threshold (:func:`confidence_features`)."""
         th = self.theta_[n]
         return confidence_features(bar_lengths(diagram, n), th.q, th.delta, th.tau)[0]
 
-    def length_thresholds(self, diagram: Diagram, cover_radius: float | None = None) -> dict[int, float]:
+    def length_thresholds(self, diagram: Diagram) -> dict[int, float]:
         """Same as :meth:`thresholds` (the interface shared with the ratio classifier)."""
         return self.thresholds(diagram)
 
-    def region_confidence(self, windows, voted=None) -> dict[int, float | None]:
+    def pooled_betti(self, windows: Sequence[Diagram]) -> dict[int, int]:
+        """A region's beta_hat_n over its windows' diagrams: the lower median of their counts."""
+        from .ratio import median_vote
+
+        counts = [self.betti(d) for d in windows]
+        return {n: median_vote([c[n] for c in counts]) for n in counts[0]}
+
+    def region_confidence(self, windows: Sequence[Diagram], voted=None) -> dict[int, float | None]:
         """Confidence of a region mapped in windows: that of its representative window
         (``voted``: :func:`swarmtopo.ratio.vote`'s result, when the caller has it)."""
         from .ratio import vote
 
         _, rep, _ = voted or vote(self, windows)
-        return self.confidence(windows[rep].diagram)
+        return self.confidence(windows[rep])
 
     def confidence(self, diagram: Diagram) -> dict[int, float | None]:
         """P(beta_hat_n is right) from the calibrated (margin, gap) model; None if uncalibrated."""

@@ -36,7 +36,7 @@ from .io import jsonable
 from .landmarks import SUBSAMPLERS, Landmarks, knn_distances, knn_maxmin, maxmin, probabilistic_maxmin
 from .log import EncounterLog
 from .persistence import Diagram, PersistenceResult, rips_persistence
-from .ratio import WindowBars, longest_bars, vote
+from .ratio import longest_bars, vote
 
 
 MIN_REGION_AGENTS = 3
@@ -467,15 +467,15 @@ def map_encounters(
             windows = [_map_window(None, whole, n_land, config, rng, timings, say)]
         say("classify")
         t0 = time.perf_counter()
-        bars = [WindowBars(w.diagram, w.scales.cover_radius) for w in windows]
-        voted = vote(classifier, bars)
+        diagrams = [w.diagram for w in windows]
+        voted = vote(classifier, diagrams)
         betti_region, rep, counts = voted
         for w, *window_counts in zip(windows, *counts.values()):
             w.betti = dict(zip(counts, window_counts))
         chosen = windows[rep]
-        confidence_region = classifier.region_confidence(bars, voted)
+        confidence_region = classifier.region_confidence(diagrams, voted)
         counted = {n: longest_bars(chosen.diagram, n, count) for n, count in betti_region.items()}
-        thresholds = classifier.length_thresholds(chosen.diagram, chosen.scales.cover_radius)
+        thresholds = classifier.length_thresholds(chosen.diagram)
         timings["classify"] += time.perf_counter() - t0
         say("embedding")
         t0 = time.perf_counter()

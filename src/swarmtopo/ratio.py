@@ -68,15 +68,6 @@ LOG_RATIO_CAP = float(np.log(1e3))
 
 
 @dataclass(frozen=True)
-class WindowBars:
-    """What the classifier reads from one window of one region: its diagram (and its r_cover,
-    kept for the record; the ratio classifier reads bar lengths only)."""
-
-    diagram: Diagram
-    cover_radius: float
-
-
-@dataclass(frozen=True)
 class RatioThresholds:
     """(q_n, tau_n) of one dimension: a bar counts in its window when l > tau_n l_q."""
 
@@ -87,6 +78,13 @@ class RatioThresholds:
         return {"q": self.q, "tau": self.tau}
 
 
+def noise_length(diagram: Diagram, dim: int, q: float) -> float:
+    """l_q: the q-quantile of the window's finite dim-n bar lengths (0 without one)."""
+    length = diagram.lengths(dim)
+    finite = length[np.isfinite(length)]
+    return float(np.quantile(finite, q)) if len(finite) else 0.0
+
+
 def window_scores(diagram: Diagram, dim: int, q: float) -> np.ndarray:
     """s_(1) >= s_(2) >= ...: the clipped log-ratios ln(l / l_q) of the window's dim-n bars,
     decreasing (module docstring); empty without bars."""
@@ -94,7 +92,7 @@ def window_scores(diagram: Diagram, dim: int, q: float) -> np.ndarray:
         return np.empty(0)
     length = diagram.lengths(dim)
     finite = np.isfinite(length)
-    lq = float(np.quantile(length[finite], q)) if finite.any() else 0.0
+    lq = noise_length(diagram, dim, q)
     scores = np.full(len(length), LOG_RATIO_CAP)
     if lq > 0:
         with np.errstate(divide="ignore"):
@@ -143,27 +141,27 @@ def median_vote(counts: Sequence[int]) -> int:
     return ordered[(len(ordered) - 1) // 2]
 
 
-def vote(classifier, windows: Sequence[WindowBars]) -> tuple[dict[int, int], int, dict[int, list[int]]]:
-    """A region's beta_hat from its windows: (vote, representative window, counts per window).
+def vote(classifier, windows: Sequence[Diagram]) -> tuple[dict[int, int], int, dict[int, list[int]]]:
+    """A region's beta_hat from its windows' diagrams: (vote, representative window, counts per window).
 
     ``classifier`` is a :class:`RatioClassifier` (pooled as its ``pooling`` says) or the
     paper-form :class:`~swarmtopo.classify.BettiClassifier` (the lower median of the
-    windows' counts).  The representative window is, among those whose own count
-    equals the vote in the lowest dimension (or, if none does, is nearest it), the one
-    whose nearest bar is farthest from the threshold (the first on ties).
+    windows' counts): its ``pooled_betti``.  The representative window is, among those
+    whose own count equals the vote in the lowest dimension (or, if none does, is
+    nearest it), the one whose nearest bar is farthest from the threshold (the first on
+    ties).
     """
     if not windows:
         raise SwarmtopoError("no window of this region has enough events to map")
-    per_window = [classifier.betti(w.diagram) for w in windows]
+    per_window = [classifier.betti(d) for d in windows]
     counts = {n: [c[n] for c in per_window] for n in per_window[0]}
-    pooled = getattr(classifier, "pooled_betti", None)
-    betti = pooled(windows) if pooled else {n: median_vote(c) for n, c in counts.items()}
+    betti = classifier.pooled_betti(windows)
     if not counts:
         return betti, 0, counts
     key = min(counts)
     off = [abs(c - betti[key]) for c in counts[key]]
     nearest = [i for i, x in enumerate(off) if x == min(off)]
-    margins = [classifier.margin(windows[i].diagram, windows[i].cover_radius, key) for i in nearest]
+    margins = [classifier.margin(windows[i], key) for i in nearest]
     return betti, nearest[int(np.argmax(margins))], counts
 
 
@@ -199,58 +197,50 @@ class RatioClassifier:
         self.pooling = pooling
 
     # -- one window --------------------------------------------------------------------
-    def betti(self, diagram: Diagram, cover_radius: float | None = None) -> dict[int, int]:
-        """The window's own beta_hat_n, for n up to the diagram's maxdim (``cover_radius``
-        is not used)."""
+    def betti(self, diagram: Diagram) -> dict[int, int]:
+        """The window's own beta_hat_n, for n up to the diagram's maxdim."""
         return {n: count_above(window_scores(diagram, n, th.q), th.tau)
                 for n, th in self.thresholds_.items() if n <= diagram.maxdim}
 
-    def length_thresholds(self, diagram: Diagram, cover_radius: float | None = None) -> dict[int, float]:
+    def length_thresholds(self, diagram: Diagram) -> dict[int, float]:
         """tau_n l_q: the length a bar of this window must exceed to count in it, seconds."""
-        out = {}
-        for n, th in self.thresholds_.items():
-            if n > diagram.maxdim:
-                continue
-            lengths = diagram.lengths(n)
-            finite = lengths[np.isfinite(lengths)]
-            out[n] = th.tau * (float(np.quantile(finite, th.q)) if len(finite) else 0.0)
-        return out
+        return {n: th.tau * noise_length(diagram, n, th.q)
+                for n, th in self.thresholds_.items() if n <= diagram.maxdim}
 
-    def margin(self, diagram: Diagram, cover_radius: float | None, n: int) -> float:
+    def margin(self, diagram: Diagram, n: int) -> float:
         """How far the window's own count in dimension n is from changing (:func:`score_margin`)."""
         th = self.thresholds_[n]
         return score_margin(window_scores(diagram, n, th.q), th.tau)
 
     # -- a region: several windows --------------------------------------------------------
-    def pooled_betti(self, windows: Sequence[WindowBars]) -> dict[int, int]:
+    def pooled_betti(self, windows: Sequence[Diagram]) -> dict[int, int]:
         """The region's beta_hat_n: pooled scores (``"mean"``) or the lower median of the
         windows' counts (``"median"``)."""
-        maxdim = windows[0].diagram.maxdim
+        maxdim = windows[0].maxdim
         if self.pooling == "median":
-            return {n: median_vote([self.betti(w.diagram)[n] for w in windows])
-                    for n in self.thresholds_ if n <= maxdim}
-        return {n: count_above(pooled_scores([w.diagram for w in windows], n, th.q), th.tau)
+            return {n: median_vote([self.betti(d)[n] for d in windows]) for n in self.thresholds_ if n <= maxdim}
+        return {n: count_above(pooled_scores(windows, n, th.q), th.tau)
                 for n, th in self.thresholds_.items() if n <= maxdim}
 
-    def region_features(self, windows: Sequence[WindowBars], n: int, voted=None) -> np.ndarray:
+    def region_features(self, windows: Sequence[Diagram], n: int, voted=None) -> np.ndarray:
         """(agreement a, margin m, number of windows) of one region for dimension n;
         ``voted`` is :func:`vote`'s result for these windows when the caller has it."""
         betti, rep, counts = voted or vote(self, windows)
         agreement = float(np.mean(np.asarray(counts[n]) == betti[n]))
         th = self.thresholds_[n]
         if self.pooling == "median":
-            margin = self.margin(windows[rep].diagram, windows[rep].cover_radius, n)
+            margin = self.margin(windows[rep], n)
         else:
-            margin = score_margin(pooled_scores([w.diagram for w in windows], n, th.q), th.tau)
+            margin = score_margin(pooled_scores(windows, n, th.q), th.tau)
         return np.array([agreement, margin, float(len(windows))])
 
-    def region_confidence(self, windows: Sequence[WindowBars], voted=None) -> dict[int, float | None]:
+    def region_confidence(self, windows: Sequence[Diagram], voted=None) -> dict[int, float | None]:
         """P(the region's beta_hat_n is right) from the calibrated model; None if uncalibrated.
         ``voted``: :func:`vote`'s result for these windows, when the caller has it."""
         voted = voted or vote(self, windows)
         out: dict[int, float | None] = {}
         for n in self.thresholds_:
-            if n > windows[0].diagram.maxdim:
+            if n > windows[0].maxdim:
                 continue
             model = self.calibration_.get(str(n))
             if model is None:

@@ -37,7 +37,7 @@ from ..arena import HOLE_SHAPES, OUTER_SHAPES
 from ..cycles import wilson_interval
 from ..errors import SwarmtopoError
 from ..persistence import Diagram
-from ..ratio import WindowBars, vote
+from ..ratio import vote
 from ..pipeline import MapConfig
 from .grid import Job, canonical_json, case_streams
 from .sweep import build_arena
@@ -221,8 +221,7 @@ def outcomes(rows, classifier) -> list[dict[str, Any]]:
         config = row["config"]
         est0, est1, conf0, conf1 = row["est_betti0"], None, None, None
         if row["error"] is None:
-            regions = [[WindowBars(Diagram.from_json(w["diagram"]), float(w["cover_radius"])) for w in r["windows"]]
-                       for r in row["diagrams"]]
+            regions = [[Diagram.from_json(w["diagram"]) for w in r["windows"]] for r in row["diagrams"]]
             votes = [vote(classifier, windows) for windows in regions]
             est1 = sum(voted[0].get(1, 0) for voted in votes)
             confs = [classifier.region_confidence(windows, voted).get(1) for windows, voted in zip(regions, votes)]

@@ -4,9 +4,10 @@
 (:func:`~.accuracy.tuning_jobs`, inside :func:`~.accuracy.tuning_session`), then for
 each candidate fits the :class:`~swarmtopo.ratio.RatioClassifier` thresholds
 (q_1, tau_1) by grid search on the stored per-window diagrams -- the thresholds change
-only which bars count, so no job is rerun -- and keeps the candidate with the most
-exact (beta_0, beta_1) maps.  The confidence model is then fitted on the same tuning
-maps, cross-fitted (:func:`calibrated_classifier`).
+only which bars count, so no job is rerun -- for each way of pooling the windows, with
+a cross-validated count beside the fitted one (:func:`cross_validated`).  The
+confidence model of the chosen candidate is then fitted on the same tuning maps,
+cross-fitted (:func:`calibrated_classifier`).
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import numpy as np
 from scipy.ndimage import uniform_filter1d
 
 from ..persistence import Diagram
-from ..ratio import RatioClassifier, RatioThresholds, WindowBars, pooled_scores, window_scores
+from ..ratio import RatioClassifier, RatioThresholds, pooled_scores, window_scores
 
 Q_GRID = (0.5, 0.6, 0.7, 0.8, 0.9)
 TAU_GRID = tuple(np.round(np.geomspace(1.2, 12.0, 80), 4))
@@ -29,7 +30,7 @@ TAU_GRID = tuple(np.round(np.geomspace(1.2, 12.0, 80), 4))
 class TuningMap:
     """One tuning map: its regions' windows, its estimated beta_0 and the truth."""
 
-    regions: tuple[tuple[WindowBars, ...], ...]
+    regions: tuple[tuple[Diagram, ...], ...]  # each region's windows' diagrams
     est_betti0: int
     true_betti0: int
     true_betti1: int
@@ -46,7 +47,7 @@ def maps_from_rows(rows: Sequence[dict[str, Any]], cell_of) -> list[TuningMap]:
         if row["error"] is not None:
             continue
         regions = tuple(
-            tuple(WindowBars(Diagram.from_json(w["diagram"]), float(w["cover_radius"])) for w in region["windows"])
+            tuple(Diagram.from_json(w["diagram"]) for w in region["windows"])
             for region in row["diagrams"])
         maps.append(TuningMap(regions, int(row["est_betti0"]), int(row["true_betti0"]), int(row["true_betti1"]),
                               cell_of(row["config"])))
@@ -84,13 +85,12 @@ def grid_estimates(maps: Sequence[TuningMap], pooling: str = "mean") -> np.ndarr
     est = np.zeros((len(maps), len(Q_GRID), len(TAU_GRID)), np.int64)
     for k, m in enumerate(maps):
         for region in m.regions:
-            diagrams = [w.diagram for w in region]
             for i, q in enumerate(Q_GRID):
                 if pooling == "mean":
-                    est[k, i] += _counts_over_tau(pooled_scores(diagrams, 1, q))
+                    est[k, i] += _counts_over_tau(pooled_scores(region, 1, q))
                 else:
-                    counts = np.sort([_counts_over_tau(window_scores(d, 1, q)) for d in diagrams], axis=0)
-                    est[k, i] += counts[(len(diagrams) - 1) // 2]
+                    counts = np.sort([_counts_over_tau(window_scores(d, 1, q)) for d in region], axis=0)
+                    est[k, i] += counts[(len(region) - 1) // 2]
     return est
 
 
@@ -107,6 +107,16 @@ def fit_thresholds(maps: Sequence[TuningMap], pooling: str = "mean") -> Fit:
     i, j = np.unravel_index(int(np.argmax(smooth + 1e-9 * surface)), surface.shape)
     return Fit(thresholds=RatioThresholds(float(Q_GRID[i]), float(TAU_GRID[j])), accuracy=float(surface[i, j]),
                surface=surface, pooling=pooling)
+
+
+def cross_validated(maps: Sequence[TuningMap], pooling: str = "mean", folds: int = 4) -> int:
+    """Exact maps when each fold (maps split by position) is read with the thresholds
+    fitted on the other folds: the fitted count without its in-sample optimism."""
+    fold = np.arange(len(maps)) % folds
+    return sum(int(exact([m for m, f in zip(maps, fold) if f == k],
+                         fit_thresholds([m for m, f in zip(maps, fold) if f != k], pooling).thresholds,
+                         pooling).sum())
+               for k in range(folds))
 
 
 def calibrated_classifier(maps: Sequence[TuningMap], fit: Fit, provenance: dict, folds: int = 5) -> RatioClassifier:
