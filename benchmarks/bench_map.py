@@ -20,7 +20,10 @@ start, medians of 3, same landmarks and distances asserted.  The graph and the
 persistence stages are the same for both, so they are left out.  Targets: >= 20x
 faster, >= 50x less memory (peak RSS above the level before the call).
 
-    python benchmarks/bench_map.py [--quick]
+    python benchmarks/bench_map.py [--quick] [--subsample maxmin ...]
+
+``--subsample`` times only the named subsamplers in part 1 (each row costs minutes at
+10^6 events).
 """
 
 from __future__ import annotations
@@ -56,7 +59,7 @@ def warm_up():
             map_encounters(log, config(metric, subsample))
 
 
-def whole_map(n_events):
+def whole_map(n_events, subsamplers=SUBSAMPLERS):
     log = simulated_log(n_events)
     print(f"\n## map_encounters at {log.n_events:,} events ({log.n_agents} agents, {log.duration:.0f} s, "
           f"{len(log.static_agent)} static, 2 holes), L = {N_LANDMARKS}, H0 + H1, one run each\n")
@@ -64,7 +67,7 @@ def whole_map(n_events):
           "peak MB above baseline | beta_0, beta_1 | target | met |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for metric in METRICS:
-        for subsample in SUBSAMPLERS:
+        for subsample in subsamplers:
             result, wall, peak, cpu = run_measured(lambda: map_encounters(log, config(metric, subsample)))
             stage = result.timings
             other = wall - stage["graph"] - stage["landmarks"] - stage["persistence"]
@@ -93,10 +96,12 @@ def against_dense(n_events, repeats=3):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="10^5 events instead of 10^6")
+    parser.add_argument("--subsample", nargs="+", choices=SUBSAMPLERS, default=list(SUBSAMPLERS),
+                        help="subsamplers to time in part 1 (default: all)")
     args = parser.parse_args()
     print(f"machine: {machine()}; {numba.get_num_threads()} numba threads; swarmtopo {revision()}")
     warm_up()
-    whole_map(10**5 if args.quick else 10**6)
+    whole_map(10**5 if args.quick else 10**6, args.subsample)
     against_dense(10**4)
     print(f"\nload average after: {os.getloadavg()[0]:.1f}")
 

@@ -37,8 +37,8 @@ from swarmtopo import __version__
 from swarmtopo.experiments.accuracy import CELLS, HELD_OUT_FAMILY, SUITE, TUNING_PER_CELL, cell_of, tuning_jobs, tuning_session
 from swarmtopo.experiments.store import read_jobs
 from swarmtopo.experiments.sweep import job_map_config, run_sweep
-from swarmtopo.experiments.tuning import (Q_GRID, TAU_GRID, calibrated_classifier, cross_validated, exact, fit_thresholds,
-                                         maps_from_rows)
+from swarmtopo.experiments.tuning import (PIPELINE_FIELDS, Q_GRID, TAU_GRID, calibrated_classifier, cross_validated, exact,
+                                         fit_thresholds, maps_from_rows)
 from swarmtopo.pipeline import MapConfig
 from swarmtopo.ratio import POOLINGS
 
@@ -70,9 +70,6 @@ CHOSEN = ("h auto, diffusive, wall following x 2, windows of 15, 20 and 25 encou
 """The default pipeline and pooling (chosen on tuning cases over three landmark draws each)."""
 CV_FOLDS = 4
 """Folds of the cross-validated count printed beside each fitted one (thresholds refitted without each fold)."""
-CHOSEN_FIELDS = ("metric", "hop_cost", "diffusion_time", "wall_follow_weight", "window_length",
-                 "window_encounters", "window_scales", "window_step")
-"""The MapConfig fields the candidates set: the chosen one's must be MapConfig's defaults."""
 
 
 def main() -> None:
@@ -111,7 +108,7 @@ def main() -> None:
                 print(f"{name}, {pooling} pooling: {fit.thresholds}: {right.sum()}/{len(candidate_rows)} "
                       f"({CV_FOLDS}-fold CV {cv}); paper form {sum(paper_form)}/{len(candidate_rows)}")
     defaults, chosen_config = MapConfig(), job_map_config(jobs[CHOSEN[0]][0].config["map"])
-    mismatch = {k: (getattr(defaults, k), getattr(chosen_config, k)) for k in CHOSEN_FIELDS
+    mismatch = {k: (getattr(defaults, k), getattr(chosen_config, k)) for k in PIPELINE_FIELDS
                 if getattr(defaults, k) != getattr(chosen_config, k)}
     if mismatch:
         raise SystemExit(f"MapConfig defaults differ from the chosen pipeline: {mismatch}; update swarmtopo/pipeline.py")

@@ -287,6 +287,22 @@ def test_windowed_map_pools_and_records_its_windows():
     assert "mean time between an agent's encounters" in doc["params"]["diffusion_time_source"]
 
 
+def test_advice_comes_below_the_threshold_and_names_what_would_raise_it():
+    import dataclasses
+
+    from swarmtopo.pipeline import ADVICE_BELOW
+
+    log = simulate(default_arena(), 150, 30.0, rng=2).log
+    tmap = map_encounters(log, MapConfig(window_length=12.0, window_scales=(1.0,), **FAST))
+    sure = dataclasses.replace(tmap, confidence={0: 0.99, 1: ADVICE_BELOW})
+    assert sure.advice() == [] and sure.to_json()["advice"] == []
+    unsure = dataclasses.replace(tmap, confidence={0: 0.99, 1: ADVICE_BELOW - 0.2})
+    advice = unsure.advice()
+    assert advice[0] == f"beta_1 = {tmap.betti[1]} is uncertain ({100 * (ADVICE_BELOW - 0.2):.0f}% confidence)"
+    assert advice[-1].startswith("to raise it: record longer") and "more agents than 150" in advice[-1]
+    assert "swarmtopo plan" in advice[-1] and unsure.to_json()["advice"] == advice
+
+
 def test_paper_pipeline_is_the_whole_log_without_hop_cost():
     log = simulate(default_arena(), 150, 30.0, rng=2).log
     tmap = map_encounters(log, MapConfig(hop_cost=0.0, diffusion_time=WHOLE_LOG, wall_follow_weight=None,

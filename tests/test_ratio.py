@@ -8,8 +8,9 @@ from hypothesis import strategies as st
 from swarmtopo.classify import load_classifier
 from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.persistence import Diagram
-from swarmtopo.ratio import (LOG_RATIO_CAP, MAX_MARGIN, RatioClassifier, RatioThresholds, longest_bars,
-                             median_vote, pooled_scores, score_margin, vote, window_scores)
+from swarmtopo.ratio import (LOG_RATIO_CAP, MAX_MARGIN, SCORE_VAR_PRIOR, Z_CAP, RatioClassifier, RatioThresholds,
+                             longest_bars, median_vote, pooled_scores, score_matrix, score_margin,
+                             standardised_margin, vote, window_scores)
 
 TH = RatioThresholds(q=0.5, tau=2.0)
 
@@ -55,7 +56,13 @@ def test_mean_pooling_hand_computed_against_the_median():
     assert betti == {1: 1} and counts == {1: [1, 0]} and rep == 0  # the window that agrees
     assert vote(median, w)[:2] == ({1: 0}, 1)
     # agreement 1/2; margin: S_1 is ln(sqrt 6) - ln 2 above, S_2 = 0 is ln 2 below
-    assert mean.region_features(w, 1) == pytest.approx([0.5, np.log(np.sqrt(6) / 2), 2.0])
+    features = mean.region_features(w, 1)
+    assert [features[k] for k in ("agreement", "margin", "windows")] == pytest.approx(
+        [0.5, np.log(np.sqrt(6) / 2), np.log(2)])
+    # z: rank 1 scores ln 4 and ln 1.5 (variance (ln 4 - ln 1.5)^2 / 2 with ddof 1), rank 2 scores 0 and 0
+    se1 = np.sqrt(((np.log(4) - np.log(1.5)) ** 2 / 2 + SCORE_VAR_PRIOR) / 2)
+    se2 = np.sqrt(SCORE_VAR_PRIOR / 2)
+    assert features["z"] == pytest.approx(min((np.log(np.sqrt(6)) - np.log(2)) / se1, np.log(2) / se2))
 
 
 def test_a_missing_rank_scores_zero():
@@ -75,6 +82,41 @@ def test_score_margin_and_longest_bars_hand_computed():
     d = diagram([[1, 2], [0, 5], [1, np.inf], [2, 6]])
     assert [tuple(d[1][i]) for i in longest_bars(d, 1, 2)] == [(1.0, np.inf), (0.0, 5.0)]
     assert list(longest_bars(d, 1, 0)) == []
+
+
+def test_standardised_margin_hand_computed():
+    # three windows, ranks 1-3; S = (2, 0.5, 0); ln tau = 1: the vote is 1
+    matrix = np.array([[2.5, 0.5, 0.0], [2.0, 1.0, 0.0], [1.5, 0.0, 0.0]])
+    se = np.sqrt((np.array([0.25, 0.25, 0.0]) + SCORE_VAR_PRIOR) / 3)  # ddof-1 variances 0.25, 0.25, 0
+    z_above, z_below = (2.0 - 1.0) / se[0], (1.0 - 0.5) / se[1]
+    assert standardised_margin(matrix, 1, np.e) == pytest.approx(min(z_above, z_below))
+    # a vote the means disagree with (a median vote can) has a negative z
+    assert standardised_margin(matrix, 2, np.e) == pytest.approx((0.5 - 1.0) / se[1])
+    # no rank left above (count 0) or below (count = every rank): that side counts as Z_CAP
+    assert standardised_margin(np.array([[0.2], [0.4]]), 0, np.e) == pytest.approx(
+        min(Z_CAP, (1.0 - 0.3) / np.sqrt((0.02 + SCORE_VAR_PRIOR) / 2)))
+    assert standardised_margin(np.array([[9.0]]), 1, np.e) == pytest.approx(min(Z_CAP, 8.0 / np.sqrt(SCORE_VAR_PRIOR)))
+    # one window: the prior alone is its variance
+    assert standardised_margin(np.array([[1.5, 0.0]]), 1, np.e) == pytest.approx(0.5 / np.sqrt(SCORE_VAR_PRIOR))
+
+
+def test_score_matrix_pads_missing_ranks_with_zero():
+    w = windows_of([[0, 8], [0, 2], [1, 3], [0, 1]], [[0, 3], [1, 3], [0, 1]])
+    assert score_matrix(w, 1, 0.5) == pytest.approx(np.array([[np.log(4), 0, 0, 0], [np.log(1.5), 0, 0, 0]]))
+    assert score_matrix(w, 1, 0.5).mean(axis=0) == pytest.approx(pooled_scores(w, 1, 0.5))
+
+
+def test_a_calibration_of_the_older_features_is_applied_as_fitted():
+    # a file calibrated before z: intercept + agreement a + margin m + ln(#windows) coefficients
+    model = RatioClassifier({1: TH}, calibration={"1": {"intercept": -1.0, "agreement": 2.0, "margin": 1.5,
+                                                        "windows": 0.5, "maps": 10}})
+    w = windows_of([[0, 8], [0, 2], [1, 3], [0, 1]], [[0, 3], [1, 3], [0, 1]])
+    a, m = 0.5, np.log(np.sqrt(6) / 2)
+    expected = 1 / (1 + np.exp(-(-1.0 + 2.0 * a + 1.5 * m + 0.5 * np.log(2))))
+    assert model.region_confidence(w)[1] == pytest.approx(expected)
+    assert "agreement" in model.describe()["confidence"]
+    with pytest.raises(InputError, match=r"unknown confidence feature\(s\) \['gap'\]"):
+        RatioClassifier({1: TH}, calibration={"1": {"intercept": 0.0, "gap": 1.0}})
 
 
 def test_median_vote_is_the_lower_median():
@@ -128,7 +170,7 @@ def test_calibration_and_json_round_trip(tmp_path):
         bars = [[1, 21], [1, 2], [1, 2]] if clean else [[1, 3.05], [1, 2], [1, 2]]
         regions.append(windows_of(bars, bars, bars))
         correct.append(clean or rng.random() < 0.3)
-    model.calibrate(np.array([model.region_features(r, 1) for r in regions]), correct,
+    model.calibrate([model.region_features(r, 1) for r in regions], correct,
                     beta0_correct=[True] * 59 + [False])
     sure = model.region_confidence(windows_of(*[[[1, 21], [1, 2], [1, 2]]] * 3))[1]
     unsure = model.region_confidence(windows_of(*[[[1, 3.05], [1, 2], [1, 2]]] * 3))[1]

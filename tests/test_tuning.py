@@ -5,10 +5,10 @@ import dataclasses
 
 import numpy as np
 
-from swarmtopo.experiments.tuning import (Q_GRID, TAU_GRID, TuningMap, calibrated_classifier, cross_validated, exact,
-                                         fit_thresholds, grid_estimates)
+from swarmtopo.experiments.tuning import (Q_GRID, TAU_GRID, TuningMap, calibrated_classifier, cross_fitted_features,
+                                         cross_validated, exact, fit_thresholds, grid_estimates)
 from swarmtopo.persistence import Diagram
-from swarmtopo.ratio import RatioThresholds
+from swarmtopo.ratio import RatioClassifier, RatioThresholds
 
 
 def window(holes, rng):
@@ -79,3 +79,19 @@ def test_cross_validated_count_reads_every_map_once_with_out_of_fold_thresholds(
     wrong = maps[:5] + [dataclasses.replace(one, est_betti0=2)] + maps[6:]  # a beta_0 no threshold fixes
     assert cross_validated(wrong, "mean", folds=5) == 19
     assert cross_validated(wrong, "mean", folds=4) == 19  # counted once, whatever the folds
+
+
+def test_cross_fitted_features_read_each_one_region_map_with_thresholds_fitted_without_it():
+    maps = synthetic_maps(15, np.random.default_rng(4))
+    maps[3] = dataclasses.replace(maps[3], true_betti1=maps[3].true_betti1 + 1)  # no threshold reads it right
+    maps[7] = dataclasses.replace(maps[7], est_betti0=2)  # beta_0 wrong: its region's outcome is unknown
+    features, correct = cross_fitted_features(maps, "mean", folds=3)
+    single = [m for i, m in enumerate(maps) if i != 7]
+    assert len(features) == len(correct) == 14
+    # the literal construction: fold k holds positions k, k + 3, ... of the one-region maps
+    order = [i for k in range(3) for i in range(len(single)) if i % 3 == k]
+    for pos, i in enumerate(order):
+        th = fit_thresholds([m for j, m in enumerate(single) if j % 3 != i % 3]).thresholds
+        assert features[pos] == RatioClassifier({1: th}).region_features(single[i].regions[0], 1)
+        assert correct[pos] == bool(exact([single[i]], th)[0])
+    assert correct[order.index(3)] is False

@@ -47,7 +47,7 @@ AUTO_COVER_FACTOR = 1.5
 region's k-NN scale).  The landmarks' diagram is within bottleneck 2 r_cover of the
 whole cloud's, so subsampling moves no bar by more than 3 s: the order of the
 cloud's own Rips noise bars."""
-ADVICE_BELOW = 0.8
+ADVICE_BELOW = 0.9
 """A Betti number reported with less confidence than this comes with advice."""
 HOP_GAP_FACTOR = 2.0
 """Without r_d and v_c in meta.json, the per-hop cost h is this many times the mean time

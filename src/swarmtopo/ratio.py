@@ -29,13 +29,20 @@ A region's log is cut into time windows of several lengths (``MapConfig.window_l
 
 Either way the counted bars of a window drawn for the user are its beta_hat_n longest.
 
-Confidence.  For each region the features are the *agreement* a (fraction of
-windows whose own count equals the vote), the *margin* m, how far in log units the
-vote is from changing -- mean pooling: min(S_beta - ln tau, ln tau - S_{beta+1}) over
-the ranks that exist; median pooling: the nearest bar's distance to the threshold in
-the representative window -- capped at MAX_MARGIN, and the number of windows.
-P(correct | a, m, number of windows) is a logistic regression fitted on the
-benchmark's tuning maps (:meth:`RatioClassifier.calibrate`).
+Confidence.  For each region the feature is the vote's *standardised margin* z:
+how many standard errors the pooled scores are from changing the vote beta,
+
+    z = min((S_beta - ln tau_n) / se_beta, (ln tau_n - S_{beta+1}) / se_{beta+1}),
+    se_k = sqrt((v_k + SCORE_VAR_PRIOR) / W),
+
+v_k the variance over the W windows of their k-th scores (0 for one window) and
+SCORE_VAR_PRIOR a prior variance, so that a few windows that happen to agree do not
+make z infinite; a side without a rank counts as Z_CAP, and z is capped there.
+P(correct | z) is a logistic regression fitted on the benchmark's tuning maps
+(:meth:`RatioClassifier.calibrate`).  Files calibrated before z existed carry
+coefficients of the windows' *agreement* with the vote, the vote's log *margin*
+(capped at MAX_MARGIN) and the log number of *windows*; they are applied as they were
+fitted (:data:`REGION_FEATURES`).
 
 Earlier files (/1, /2) could also gate bars by death/birth ratio, length in covering
 radii and a largest-gap rule; measured over three tuning rounds they never raised the
@@ -63,6 +70,15 @@ READ_FORMATS = ("swarmtopo-ratio-classifier/1", "swarmtopo-ratio-classifier/2", 
 POOLINGS = ("mean", "median")
 MAX_MARGIN = 3.0
 """Cap of the log margin (a score e^3 = 20 times off the threshold is as sure as it gets)."""
+Z_CAP = 10.0
+"""Cap of the standardised margin z (ten standard errors from changing is as sure as it gets)."""
+SCORE_VAR_PRIOR = 0.25 ** 2
+"""Prior variance of a window's score at one rank (log units squared): se_k never falls below 0.25 / sqrt(W)."""
+CONFIDENCE_FEATURES = ("z",)
+"""The features :meth:`RatioClassifier.calibrate` fits."""
+REGION_FEATURES = ("z", "agreement", "margin", "windows")
+"""Every feature :meth:`RatioClassifier.region_features` gives: a calibration may weigh any of
+them (files calibrated before z weigh the last three)."""
 LOG_RATIO_CAP = float(np.log(1e3))
 """Cap of a bar's score: a bar 1000 times the typical noise loop (or infinite) is as long as it gets."""
 
@@ -102,13 +118,34 @@ def window_scores(diagram: Diagram, dim: int, q: float) -> np.ndarray:
     return np.sort(scores)[::-1]
 
 
+def score_matrix(diagrams: Sequence[Diagram], dim: int, q: float) -> np.ndarray:
+    """(W, K) scores s^w_(k) of the W windows, a rank a window has no bar for scoring 0."""
+    ranked = [window_scores(d, dim, q) for d in diagrams]
+    out = np.zeros((len(ranked), max((len(s) for s in ranked), default=0)))
+    for w, s in enumerate(ranked):
+        out[w, :len(s)] = s
+    return out
+
+
 def pooled_scores(diagrams: Sequence[Diagram], dim: int, q: float) -> np.ndarray:
     """S_k: the mean over windows of their k-th score, a missing rank scoring 0 (module docstring)."""
-    ranked = [window_scores(d, dim, q) for d in diagrams]
-    out = np.zeros(max((len(s) for s in ranked), default=0))
-    for s in ranked:
-        out[:len(s)] += s
-    return out / max(len(ranked), 1)
+    matrix = score_matrix(diagrams, dim, q)
+    return matrix.mean(axis=0) if len(matrix) else np.zeros(0)
+
+
+def standardised_margin(matrix: np.ndarray, count: int, tau: float) -> float:
+    """z of a vote of ``count`` from the windows' score ``matrix`` (:func:`score_matrix`):
+    the nearer of S_count and S_{count+1} to ln tau in standard errors (module docstring)."""
+    n_windows, n_ranks = matrix.shape
+    means = matrix.mean(axis=0)
+    var = matrix.var(axis=0, ddof=1) if n_windows > 1 else np.zeros(n_ranks)
+    se = np.sqrt((var + SCORE_VAR_PRIOR) / n_windows)
+    sides = [Z_CAP]
+    if count >= 1:
+        sides.append((means[count - 1] - np.log(tau)) / se[count - 1])
+    if count < n_ranks:
+        sides.append((np.log(tau) - means[count]) / se[count])
+    return float(min(sides))
 
 
 def count_above(scores: np.ndarray, tau: float) -> int:
@@ -173,8 +210,9 @@ class RatioClassifier:
     thresholds
         ``{n: RatioThresholds(q_n, tau_n)}`` for each homology dimension n >= 1.
     calibration
-        Per dimension ``{"intercept", "agreement", "margin", "windows"}`` of the
-        logistic P(correct), and ``"0": {"rate": ...}`` for beta_0; None = uncalibrated.
+        Per dimension the logistic P(correct): ``{"intercept", "z"}`` (older files:
+        ``"agreement", "margin", "windows"``; :meth:`region_features`), and
+        ``"0": {"rate": ...}`` for beta_0; None = uncalibrated.
     provenance
         Free-form record of how it was fitted (name, data, script).
     pooling
@@ -191,6 +229,11 @@ class RatioClassifier:
         if pooling not in POOLINGS:
             raise InputError(f"unknown pooling; expected one of {', '.join(POOLINGS)}", column="pooling",
                              value=pooling)
+        for n, model in (calibration or {}).items():
+            unknown = set(model) - {"intercept", "maps", "rate", *REGION_FEATURES}
+            if unknown:
+                raise InputError(f"unknown confidence feature(s) {sorted(unknown)}; known: "
+                                 f"{', '.join(REGION_FEATURES)}", column=f"calibration.{n}", value=model)
         self.thresholds_ = {int(n): th for n, th in sorted(thresholds.items())}
         self.calibration_ = dict(calibration or {})
         self.provenance_ = dict(provenance or {})
@@ -222,17 +265,20 @@ class RatioClassifier:
         return {n: count_above(pooled_scores(windows, n, th.q), th.tau)
                 for n, th in self.thresholds_.items() if n <= maxdim}
 
-    def region_features(self, windows: Sequence[Diagram], n: int, voted=None) -> np.ndarray:
-        """(agreement a, margin m, number of windows) of one region for dimension n;
+    def region_features(self, windows: Sequence[Diagram], n: int, voted=None) -> dict[str, float]:
+        """One region's confidence features for dimension n: z (module docstring), and the
+        agreement, capped log margin and ln #windows that older calibrations use.
         ``voted`` is :func:`vote`'s result for these windows when the caller has it."""
         betti, rep, counts = voted or vote(self, windows)
-        agreement = float(np.mean(np.asarray(counts[n]) == betti[n]))
         th = self.thresholds_[n]
+        matrix = score_matrix(windows, n, th.q)
         if self.pooling == "median":
             margin = self.margin(windows[rep], n)
         else:
-            margin = score_margin(pooled_scores(windows, n, th.q), th.tau)
-        return np.array([agreement, margin, float(len(windows))])
+            margin = score_margin(matrix.mean(axis=0), th.tau)
+        return {"z": standardised_margin(matrix, betti[n], th.tau),
+                "agreement": float(np.mean(np.asarray(counts[n]) == betti[n])),
+                "margin": margin, "windows": float(np.log(len(windows)))}
 
     def region_confidence(self, windows: Sequence[Diagram], voted=None) -> dict[int, float | None]:
         """P(the region's beta_hat_n is right) from the calibrated model; None if uncalibrated.
@@ -246,9 +292,9 @@ class RatioClassifier:
             if model is None:
                 out[n] = None
                 continue
-            a, m, k = self.region_features(windows, n, voted)
-            out[n] = float(expit(model["intercept"] + model["agreement"] * a + model["margin"] * m
-                                 + model["windows"] * np.log(k)))
+            features = self.region_features(windows, n, voted)
+            out[n] = float(expit(model["intercept"] + sum(coef * features[name] for name, coef in model.items()
+                                                          if name in features)))
         return out
 
     def beta0_confidence(self) -> float | None:
@@ -257,27 +303,24 @@ class RatioClassifier:
         return None if model is None else float(model["rate"])
 
     # -- fitting -------------------------------------------------------------------------
-    def calibrate(self, features: np.ndarray, correct, beta0_correct=None) -> "RatioClassifier":
-        """Fit P(correct | a, m, ln #windows) for dimension 1.
+    def calibrate(self, features: Sequence[dict[str, float]], correct, beta0_correct=None) -> "RatioClassifier":
+        """Fit P(correct | CONFIDENCE_FEATURES) for dimension 1.
 
-        ``features[k]`` is (a, m, #windows) of region k (:meth:`region_features`, of
-        this or of another classifier when the outcomes are cross-fitted) and
-        ``correct[k]`` whether its vote was right; ``beta0_correct`` (one bool per map)
-        gives the beta_0 rate.
+        ``features[k]`` are region k's (:meth:`region_features`, of this or of another
+        classifier when the outcomes are cross-fitted) and ``correct[k]`` whether its
+        vote was right; ``beta0_correct`` (one bool per map) gives the beta_0 rate.
         """
-        X = np.array(features, dtype=float).reshape(-1, 3)
-        X[:, 2] = np.log(X[:, 2])
+        X = np.array([[f[name] for name in CONFIDENCE_FEATURES] for f in features], dtype=float)
         y = np.asarray(correct, dtype=bool)
-        calibration: dict[str, Any] = {}
         if len(np.unique(y)) == 2:
             model = LogisticRegression(C=1.0).fit(X, y)
-            calibration["1"] = {"intercept": float(model.intercept_[0]), "agreement": float(model.coef_[0, 0]),
-                                "margin": float(model.coef_[0, 1]), "windows": float(model.coef_[0, 2]),
-                                "maps": int(len(y))}
+            intercept, coefficients = float(model.intercept_[0]), model.coef_[0]
         else:  # all right (or all wrong): the smoothed rate, whatever the features
             rate = (y.sum() + 1) / (len(y) + 2)
-            calibration["1"] = {"intercept": float(np.log(rate / (1 - rate))), "agreement": 0.0,
-                                "margin": 0.0, "windows": 0.0, "maps": int(len(y))}
+            intercept, coefficients = float(np.log(rate / (1 - rate))), np.zeros(len(CONFIDENCE_FEATURES))
+        calibration: dict[str, Any] = {"1": {"intercept": intercept, **dict(zip(CONFIDENCE_FEATURES,
+                                                                                 map(float, coefficients))),
+                                             "maps": int(len(y))}}
         if beta0_correct is not None:
             ok = np.asarray(beta0_correct, dtype=bool)
             calibration["0"] = {"rate": float((ok.sum() + 1) / (len(ok) + 2)), "maps": int(len(ok))}
@@ -297,10 +340,18 @@ class RatioClassifier:
             "definition": f"beta_n = {pooled}",
             "pooling": self.pooling,
             "theta": {str(n): th.to_json() for n, th in self.thresholds_.items()},
-            "confidence": "P(correct) from a logistic model of the windows' agreement with the vote, the "
-                          "vote's log margin and the number of windows, fitted on the benchmark's "
-                          "tuning maps; beta_0: tuning-set rate",
+            "confidence": self._confidence_definition(),
         }
+
+    def _confidence_definition(self) -> str:
+        model = self.calibration_.get("1")
+        if model is None:
+            return "uncalibrated"
+        if "z" in model:
+            return ("P(correct) from a logistic model of z, how many standard errors (over the windows) the pooled "
+                    "scores are from changing the vote, fitted on the benchmark's tuning maps; beta_0: tuning-set rate")
+        return ("P(correct) from a logistic model of the windows' agreement with the vote, the vote's log margin and "
+                "the number of windows, fitted on the benchmark's tuning maps; beta_0: tuning-set rate")
 
     def to_json(self) -> dict[str, Any]:
         return {

@@ -57,7 +57,7 @@ QUICK_PER_CELL = 10
 SLICE_PER_CELL = 2
 """The regression slice: the first SLICE_PER_CELL reporting cases of every cell
 (default pipeline), rerun by tests/test_accuracy.py against the rate recorded here."""
-TUNING_PER_CELL = 48
+TUNING_PER_CELL = 96
 
 PIPELINES: dict[str, dict[str, Any]] = {
     "default": {"metric": "hybrid", "hop_cost": "auto", "diffusion_time": "auto",

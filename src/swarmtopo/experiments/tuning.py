@@ -7,7 +7,7 @@ each candidate fits the :class:`~swarmtopo.ratio.RatioClassifier` thresholds
 only which bars count, so no job is rerun -- for each way of pooling the windows, with
 a cross-validated count beside the fitted one (:func:`cross_validated`).  The
 confidence model of the chosen candidate is then fitted on the same tuning maps,
-cross-fitted (:func:`calibrated_classifier`).
+cross-fitted (:func:`calibrated_classifier`, :func:`cross_fitted_features`).
 """
 
 from __future__ import annotations
@@ -24,6 +24,10 @@ from ..ratio import RatioClassifier, RatioThresholds, pooled_scores, window_scor
 Q_GRID = (0.5, 0.6, 0.7, 0.8, 0.9)
 TAU_GRID = tuple(np.round(np.geomspace(1.2, 12.0, 80), 4))
 """The (q_1, tau_1) grid."""
+PIPELINE_FIELDS = ("metric", "hop_cost", "diffusion_time", "wall_follow_weight", "window_length",
+                   "window_encounters", "window_scales", "window_step")
+"""The MapConfig fields the candidate pipelines of ``scripts/tune_accuracy.py`` set: the
+chosen candidate's must be MapConfig's defaults."""
 
 
 @dataclass(frozen=True)
@@ -119,26 +123,38 @@ def cross_validated(maps: Sequence[TuningMap], pooling: str = "mean", folds: int
                for k in range(folds))
 
 
-def calibrated_classifier(maps: Sequence[TuningMap], fit: Fit, provenance: dict, folds: int = 5) -> RatioClassifier:
-    """The fitted classifier with its confidence calibrated by cross-fitting.
+def cross_fitted_features(maps: Sequence[TuningMap], pooling: str = "mean",
+                          folds: int = 5) -> tuple[list[dict[str, float]], list[bool]]:
+    """Confidence features and outcomes of the one-region maps, each read with thresholds
+    fitted without it.
 
-    The thresholds were chosen on these very maps, so their outcomes under them are
-    optimistic.  Instead the maps are split into ``folds`` (by position); for each
-    fold the thresholds are refitted on the other folds and the fold's regions get
-    their features and outcomes from that refit.  The logistic model is fitted on
-    those out-of-fold pairs and then used with the final thresholds.  A region's
-    outcome is known only when the map has one region (the truth is per map): maps
-    whose beta_0 is 1 and right; beta_0's rate uses all maps.
+    The maps whose beta_0 is 1 and right (a region's outcome is known only when the
+    map has one region: the truth is per map) are split into ``folds`` by position;
+    for each fold the thresholds are refitted on the other folds, and the fold's
+    regions get their :meth:`~swarmtopo.ratio.RatioClassifier.region_features` and
+    whether their beta_1 is right from that refit.
     """
     single = [m for m in maps if m.true_betti0 == 1 and m.est_betti0 == 1]
     fold = np.arange(len(single)) % folds
     features, correct = [], []
     for k in range(folds):
         held = [m for m, f in zip(single, fold) if f == k]
-        th = fit_thresholds([m for m, f in zip(single, fold) if f != k], fit.pooling).thresholds
-        refit = RatioClassifier({1: th}, pooling=fit.pooling)
+        th = fit_thresholds([m for m, f in zip(single, fold) if f != k], pooling).thresholds
+        refit = RatioClassifier({1: th}, pooling=pooling)
         features += [refit.region_features(m.regions[0], 1) for m in held]
-        correct += list(exact(held, th, fit.pooling))
+        correct += [bool(ok) for ok in exact(held, th, pooling)]
+    return features, correct
+
+
+def calibrated_classifier(maps: Sequence[TuningMap], fit: Fit, provenance: dict, folds: int = 5) -> RatioClassifier:
+    """The fitted classifier with its confidence calibrated by cross-fitting.
+
+    The thresholds were chosen on these very maps, so their outcomes under them are
+    optimistic.  The logistic model is fitted on out-of-fold features and outcomes
+    (:func:`cross_fitted_features`) and then used with the final thresholds;
+    beta_0's rate uses all maps.
+    """
+    features, correct = cross_fitted_features(maps, fit.pooling, folds)
     model = RatioClassifier({1: fit.thresholds}, provenance={**provenance, "calibration": f"{folds}-fold cross-fitted"},
                             pooling=fit.pooling)
-    return model.calibrate(np.array(features), correct, beta0_correct=[m.est_betti0 == m.true_betti0 for m in maps])
+    return model.calibrate(features, correct, beta0_correct=[m.est_betti0 == m.true_betti0 for m in maps])
