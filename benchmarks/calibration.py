@@ -4,11 +4,11 @@ Reads the default pipeline's maps from a tuning store written by
 ``scripts/tune_accuracy.py`` (tuning cases only: the reporting cases are closed to
 that script), takes each one-region map's confidence features and outcome read with
 thresholds fitted without it (``experiments.tuning.cross_fitted_features``, 5 folds,
-as the shipped calibration), and for each feature set fits the logistic P(right) the
-way ``RatioClassifier.calibrate`` does, predicting each map from a model fitted without
-it (scikit-learn ``cross_val_predict``, 10 folds by position).  Prints the Brier score
-and log loss of those predictions against a constant confidence equal to the rate, and
-the reliability table in the bins of the accuracy benchmark.
+as the shipped calibration), and for each feature set fits the logistic P(right) of
+``RatioClassifier.calibrate`` (``ratio.confidence_model``), predicting each map from a
+model fitted without it (scikit-learn ``cross_val_predict``, 10 folds by position).
+Prints the Brier score (against a constant confidence equal to the rate) and log loss
+of those predictions, and the reliability table in the bins of the accuracy benchmark.
 
 Feature sets: ``z`` (shipped: how many standard errors the pooled scores are from
 changing the vote, ``ratio.standardised_margin``); the previous calibration's
@@ -23,7 +23,7 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
-from sklearn.linear_model import LogisticRegression
+from sklearn.metrics import log_loss
 from sklearn.model_selection import KFold, cross_val_predict
 
 from swarmtopo.experiments.accuracy import cell_of, reliability
@@ -31,9 +31,10 @@ from swarmtopo.experiments.store import read_jobs
 from swarmtopo.experiments.sweep import job_map_config
 from swarmtopo.experiments.tuning import PIPELINE_FIELDS, cross_fitted_features, maps_from_rows
 from swarmtopo.pipeline import MapConfig
+from swarmtopo.ratio import CONFIDENCE_FEATURES, confidence_design, confidence_model
 
 FEATURE_SETS = {
-    "z (shipped)": ("z",),
+    "z (shipped)": CONFIDENCE_FEATURES,
     "agreement, margin, ln windows (previous)": ("agreement", "margin", "windows"),
     "z, agreement, margin, ln windows": ("z", "agreement", "margin", "windows"),
 }
@@ -59,11 +60,11 @@ def main() -> None:
     print(f"{args.store}: {len(maps)} default-pipeline tuning maps, {len(y)} with one region; "
           f"{int((~y).sum())} wrong when read with thresholds fitted without them")
     for name, columns in FEATURE_SETS.items():
-        X = np.array([[f[c] for c in columns] for f in features])
-        p = cross_val_predict(LogisticRegression(C=1.0), X, y, cv=KFold(10), method="predict_proba")[:, 1]
+        X = confidence_design(features, columns)
+        p = cross_val_predict(confidence_model(), X, y, cv=KFold(10), method="predict_proba")[:, 1]
         rel = reliability([{"confidence_betti1": pi, "betti1_right": bool(yi)} for pi, yi in zip(p, y)], 1)
-        log_loss = -np.mean(np.log(np.where(y, p, 1 - p)))
-        print(f"\n{name}: Brier {rel['brier']:.4f} (constant {rel['brier_constant']:.4f}), log loss {log_loss:.4f}")
+        print(f"\n{name}: Brier {rel['brier']:.4f} (constant {rel['brier_constant']:.4f}), "
+              f"log loss {log_loss(y, p):.4f}")
         print("| confidence | maps | mean confidence | fraction right |")
         print("|---|---|---|---|")
         for b in rel["bins"]:

@@ -118,6 +118,16 @@ def window_scores(diagram: Diagram, dim: int, q: float) -> np.ndarray:
     return np.sort(scores)[::-1]
 
 
+def confidence_model() -> LogisticRegression:
+    """The (unfitted) logistic model :meth:`RatioClassifier.calibrate` fits on :func:`confidence_design`."""
+    return LogisticRegression(C=1.0)
+
+
+def confidence_design(features: Sequence[dict[str, float]], names: Sequence[str] = CONFIDENCE_FEATURES) -> np.ndarray:
+    """(regions, len(names)) matrix of the named features (:meth:`RatioClassifier.region_features`) of each region."""
+    return np.array([[f[name] for name in names] for f in features], dtype=float).reshape(-1, len(names))
+
+
 def score_matrix(diagrams: Sequence[Diagram], dim: int, q: float) -> np.ndarray:
     """(W, K) scores s^w_(k) of the W windows, a rank a window has no bar for scoring 0."""
     ranked = [window_scores(d, dim, q) for d in diagrams]
@@ -310,10 +320,10 @@ class RatioClassifier:
         classifier when the outcomes are cross-fitted) and ``correct[k]`` whether its
         vote was right; ``beta0_correct`` (one bool per map) gives the beta_0 rate.
         """
-        X = np.array([[f[name] for name in CONFIDENCE_FEATURES] for f in features], dtype=float)
+        X = confidence_design(features)
         y = np.asarray(correct, dtype=bool)
         if len(np.unique(y)) == 2:
-            model = LogisticRegression(C=1.0).fit(X, y)
+            model = confidence_model().fit(X, y)
             intercept, coefficients = float(model.intercept_[0]), model.coef_[0]
         else:  # all right (or all wrong): the smoothed rate, whatever the features
             rate = (y.sum() + 1) / (len(y) + 2)
