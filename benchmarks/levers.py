@@ -30,7 +30,13 @@ diffusion time, wall following x 2):
 * ``geodesic`` -- Vietoris-Rips on geodesic distances of a k-NN graph of the landmarks
   (k = 10, joined with a minimum spanning tree so it is connected): the Isomap-style
   re-estimate of the landmark metric from its shortest distances only.
-* ``hop-half``, ``hop-double`` -- half and twice the default hop cost h.
+* ``hop-half``, ``hop-double`` -- half and twice the default hop cost h; ``hop-data`` the
+  hop cost a log without r_d and v_c gets, ``HOP_GAP_FACTOR`` x the mean time between an
+  agent's encounters.
+* ``trace/VARIANT`` -- any variant mapping only the encounters of the log, as a real
+  contact trace gives them (``experiments.sweep.contact_trace``: no status changes, so
+  no wall following; no r_d or speeds, so h from the data); ``trace/default`` the
+  default pipeline so.
 * ``dense`` -- up to 800 landmarks, covering radius down to 1 x the k-NN scale (the
   default: 400, 1.5 x).
 * ``diffusive-C`` -- diffusion time tau = C x the mean time between an agent's
@@ -98,7 +104,7 @@ from swarmtopo.embed import mds
 from swarmtopo.errors import SwarmtopoError
 from swarmtopo.experiments.accuracy import CELLS, case, tuning_session
 from swarmtopo.experiments.grid import case_streams
-from swarmtopo.experiments.sweep import build_arena, stripped_log
+from swarmtopo.experiments.sweep import build_arena, contact_trace, stripped_log
 from swarmtopo.experiments.tuning import TuningMap, cross_validated, exact, fit_thresholds
 from swarmtopo.persistence import Diagram, rips_persistence
 from swarmtopo.pipeline import WHOLE_LOG, MapConfig, map_encounters, mean_agent_gap, resolve_window
@@ -396,6 +402,9 @@ def _variant(name):
     if "@" in name:
         base, offset = name.rsplit("@", 1)
         return lambda log, seed: _variant(base)(log, seed + int(offset))
+    if name.startswith("trace/"):
+        inner = _variant(name.split("/", 1)[1])
+        return lambda log, seed: inner(contact_trace(log), seed)
     if name.startswith("draws-"):
         k, _, inner = name.split("-", 1)[1].partition("/")
         return lambda log, seed: _draws(log, seed, int(k), _variant(inner) if inner else None)
@@ -454,6 +463,7 @@ VARIANTS = {
     "geodesic": _geodesic,
     "hop-half": _hop_times(0.5),
     "hop-double": _hop_times(2.0),
+    "hop-data": lambda log, seed: _windows_of(log, seed, hop_cost=P.HOP_GAP_FACTOR * mean_agent_gap(log)),
     "dense": _dense,
     "mix": _window_mix,
     "hub": _hub,
@@ -484,7 +494,8 @@ def main() -> None:
     parser.add_argument("--per-cell", type=int, default=12)
     parser.add_argument("--variants", nargs="+", default=["default", "20s", "whole", "quarter", "draws", "switch"],
                         help=f"{', '.join(sorted(VARIANTS))}, diffusive-C, switch-C, log-C, wall-C, wall-none, "
-                             "smooth-HOW-K, paths-C, dtm-K, mds-D, mix-K1-K2[-whole], draws-K[/VARIANT], seed+D, tcorr-S or "
+                             "smooth-HOW-K, paths-C, dtm-K, mds-D, mix-K1-K2[-whole], draws-K[/VARIANT], trace/VARIANT, seed+D, "
+                             "tcorr-S or "
                              "FIELD=VALUE; "
                              "VARIANT@D: with the landmark draw of seed + D")
     parser.add_argument("--cells", nargs="+", metavar="TEXT",

@@ -10,6 +10,9 @@ writes
 
 * ``src/swarmtopo/data/classifier-default.json``: the classifier of the ``CHOSEN``
   candidate and pooling, its confidence calibrated on the tuning maps;
+* ``src/swarmtopo/data/classifier-trace.json``: the same for ``CHOSEN_TRACE``, the
+  chosen pipeline reading the tuning cases as contact traces (encounters only), which
+  ``map`` uses for a log without status changes;
 * ``docs/tuning.md``: every candidate's tuning accuracy (ratio classifier and the
   paper-form classifier), so what did not help is on record.
 
@@ -50,6 +53,8 @@ CANDIDATES = {
     "h auto, diffusive, wall following x 2, windows of 15, 20 and 25 encounters per agent": {
         **OURS, "window_scales": [0.75, 1.0, 1.25]},
     "the same, windows of 20 encounters per agent only": {**OURS, "window_scales": [1.0]},
+    "the first, reading a contact trace (encounters only: h from the data, no wall following)": {
+        **OURS, "window_scales": [0.75, 1.0, 1.25], "input": "contact-trace"},
     "h 0, no diffusive weights, whole log (the paper's metric)": {
         "hop_cost": 0.0, "diffusion_time": "none", "wall_follow_weight": "none", "window_length": "none"},
 }
@@ -68,6 +73,10 @@ and in docs/accuracy.md."""
 
 CHOSEN = ("h auto, diffusive, wall following x 2, windows of 15, 20 and 25 encounters per agent", "mean")
 """The default pipeline and pooling (chosen on tuning cases over three landmark draws each)."""
+CHOSEN_TRACE = ("the first, reading a contact trace (encounters only: h from the data, no wall following)", "mean")
+"""The default pipeline on logs without status changes (real contact traces): its own
+thresholds and calibration, the ``trace`` classifier, fitted on the same tuning cases
+read as contact traces (``experiments.sweep.contact_trace``)."""
 CV_FOLDS = 4
 """Folds of the cross-validated count printed beside each fitted one (thresholds refitted without each fold)."""
 
@@ -112,15 +121,17 @@ def main() -> None:
                 if getattr(defaults, k) != getattr(chosen_config, k)}
     if mismatch:
         raise SystemExit(f"MapConfig defaults differ from the chosen pipeline: {mismatch}; update swarmtopo/pipeline.py")
-    chosen = results[CHOSEN]
-    model = calibrated_classifier(chosen["maps"], chosen["fit"], provenance={
-        "name": "default", "script": "scripts/tune_accuracy.py", "suite": SUITE, "pipeline": CANDIDATES[CHOSEN[0]],
-        "tuning_cases_per_cell": args.per_cell, "held_out_family": HELD_OUT_FAMILY,
-        "tuning_maps": chosen["total"], "tuning_exact": chosen["right"] / chosen["total"], "swarmtopo": __version__})
-    model.save(ROOT / "src" / "swarmtopo" / "data" / "classifier-default.json")
+    for name, key in (("default", CHOSEN), ("trace", CHOSEN_TRACE)):
+        chosen = results[key]
+        model = calibrated_classifier(chosen["maps"], chosen["fit"], provenance={
+            "name": name, "script": "scripts/tune_accuracy.py", "suite": SUITE, "pipeline": CANDIDATES[key[0]],
+            "tuning_cases_per_cell": args.per_cell, "held_out_family": HELD_OUT_FAMILY,
+            "tuning_maps": chosen["total"], "tuning_exact": chosen["right"] / chosen["total"], "swarmtopo": __version__})
+        model.save(ROOT / "src" / "swarmtopo" / "data" / f"classifier-{name}.json")
     job_minutes = sum(r["t_total"] for candidate_rows in rows.values() for r in candidate_rows) / 60
-    _write_doc(results, CHOSEN, args, time.perf_counter() - started, summary, job_minutes)
-    print(f"chosen: {CHOSEN[0]}, {CHOSEN[1]} pooling; wrote classifier-default.json and docs/tuning.md")
+    _write_doc(results, (CHOSEN, CHOSEN_TRACE), args, time.perf_counter() - started, summary, job_minutes)
+    print(f"chosen: {CHOSEN[0]}, {CHOSEN[1]} pooling; for contact traces: {CHOSEN_TRACE[0]}, {CHOSEN_TRACE[1]} "
+          "pooling; wrote classifier-default.json, classifier-trace.json and docs/tuning.md")
 
 
 def _rows(store, jobs):
@@ -150,7 +161,9 @@ def _write_doc(results, chosen, args, seconds, summary, job_minutes) -> None:
         "maps. The paper-form column is the same maps read by the paper's classifier form trained our way "
         "(`paper-form` preset), windows voted by the lower median. The chosen row is declared in the script "
         "(`CHOSEN`), not this run's highest count: each map here is one landmark draw, and the choice was made "
-        "on tuning cases over three draws each (docs/accuracy.md).",
+        "on tuning cases over three draws each (docs/accuracy.md). The same pipeline reading the cases as contact "
+        "traces (`CHOSEN_TRACE`: encounters only, so h from the data and no wall following) gives the classifier "
+        "of logs without status changes (`trace`).",
         "",
         "| candidate | pooling | q_1 | tau_1 | exact | exact, 4-fold cross-validated | exact, paper form "
         "| worst cell | s per map |",
@@ -160,7 +173,7 @@ def _write_doc(results, chosen, args, seconds, summary, job_minutes) -> None:
     for key in ranked:
         r = results[key]
         worst = min(r["per_cell"].items(), key=lambda item: item[1][0] / max(item[1][1], 1))
-        mark = " **(chosen)**" if key == chosen else ""
+        mark = ({chosen[0]: " **(chosen)**", chosen[1]: " **(chosen for contact traces)**"}).get(key, "")
         th = r["fit"].thresholds
         lines.append(f"| {key[0]}{mark} | {key[1]} | {th.q:g} | {th.tau:g} | {r['right']}/{r['total']} = "
                      f"{r['right'] / r['total']:.2f} | {r['cv']}/{r['total']} = {r['cv'] / r['total']:.2f} | "

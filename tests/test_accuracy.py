@@ -130,3 +130,28 @@ def test_benchmark_runs_both_pipelines_on_dask_and_renders_its_table(tmp_path):
     rows = reclassify.default_rows(str(tmp_path / "acc.duckdb"))
     assert len(rows) == len(cells)
     assert acc.outcomes(rows, load_classifier("default")) == summary["records"]
+
+
+def test_contact_trace_keeps_only_the_encounters_and_maps_from_them():
+    from swarmtopo.arena import default_arena
+    from swarmtopo.experiments.sweep import contact_trace
+    from swarmtopo.pipeline import HOP_GAP_FACTOR, resolve_hop_cost
+    from swarmtopo.sim import simulate
+
+    log = simulate(default_arena(), 60, 10.0, static_fraction=0.2, rng=1).log
+    trace = contact_trace(log)
+    for name in ("t", "a", "b", "agent_ids"):
+        assert np.array_equal(getattr(trace, name), getattr(log, name))
+    assert len(log.status_t) and len(log.static_agent) and not len(trace.status_t) and not len(trace.static_agent)
+    assert {"r_d", "v_c", "dt", "simulation"} <= set(log.meta) and not {"r_d", "v_c", "v_p", "dt", "simulation",
+                                                                       "seed"} & set(trace.meta)
+    assert resolve_hop_cost(trace, None)[1].startswith(f"{HOP_GAP_FACTOR:g} x mean time")
+    trace_pipeline = {**acc.PIPELINES["default"], "input": "contact-trace"}
+    (job,) = acc.reporting_jobs(1, pipelines={"trace": trace_pipeline}, cells=acc.CELLS[3:4])
+    (default_job,) = acc.reporting_jobs(1, pipelines={"default": acc.PIPELINES["default"]}, cells=acc.CELLS[3:4])
+    row, default_row = run_job(job), run_job(default_job)
+    assert row["n_events"] == default_row["n_events"] and row["error"] is None  # the same case, simulated alike
+    assert row["diagrams"] != default_row["diagrams"]  # mapped with other weights (h from the data, no wall following)
+    bogus = acc.reporting_jobs(1, pipelines={"bogus": {**trace_pipeline, "input": "video"}}, cells=acc.CELLS[3:4])
+    with pytest.raises(ValueError, match="map input 'video' is not one of"):
+        run_job(bogus[0])

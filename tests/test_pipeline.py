@@ -11,7 +11,7 @@ from swarmtopo.errors import SwarmtopoError
 from swarmtopo.log import EncounterLog
 from swarmtopo.pipeline import (DIFFUSION_GAP_FACTOR, HOP_GAP_FACTOR, WHOLE_LOG, MapConfig, _share_landmarks,
                                 _scaled_windows, _windows, map_encounters, mean_agent_gap, resolve_diffusion_time, resolve_hop_cost,
-                                resolve_window)
+                                resolve_window, shipped_classifier_for)
 from swarmtopo.ratio import longest_bars
 from swarmtopo.sim import simulate
 
@@ -285,6 +285,35 @@ def test_windowed_map_pools_and_records_its_windows():
     assert doc["params"]["hop_cost_used"] == 2.0 and doc["params"]["hop_cost_source"] == "r_d / v_c from meta.json"
     assert doc["params"]["diffusion_time_used"] == pytest.approx(tmap.diffusion_time[0])
     assert "mean time between an agent's encounters" in doc["params"]["diffusion_time_source"]
+
+
+
+def test_loops_are_drawn_from_the_chosen_window_run_again_with_cocycles():
+    log = simulate(default_arena(), 150, 30.0, rng=2).log
+    config = dict(window_length=12.0, window_scales=(1.0,), seed=3, **FAST)
+    with_loops = map_encounters(log, MapConfig(**config)).regions[0]
+    without = map_encounters(log, MapConfig(cycles=False, **config)).regions[0]
+    assert [w.diagram.backend for w in without.windows] == ["gudhi"] * 4
+    backends = [w.diagram.backend for w in with_loops.windows]
+    assert backends[with_loops.window] == "ripser" and backends.count("gudhi") == 3
+    for a, b in zip(with_loops.windows, without.windows):  # the same diagrams whichever backend ran
+        for n in (0, 1):
+            np.testing.assert_array_equal(a.diagram[n], b.diagram[n])
+    assert with_loops.betti == without.betti and with_loops.window == without.window
+    assert len(with_loops.cycles) == with_loops.betti[1] and without.cycles == []
+
+def test_a_log_without_status_changes_is_read_by_the_trace_classifier():
+    from swarmtopo.experiments.sweep import contact_trace
+
+    log = simulate(default_arena(), 150, 30.0, rng=2).log
+    trace = contact_trace(log)
+    assert shipped_classifier_for(log) == "default" and shipped_classifier_for(trace) == "trace"
+    for source, name in ((log, "default"), (trace, "trace")):
+        tmap = map_encounters(source, MapConfig(seed=1, cycles=False, **FAST))
+        assert tmap.classifier["classifier"] == name
+        assert tmap.classifier["theta"] == load_classifier(name).describe()["theta"]
+    given = map_encounters(trace, MapConfig(seed=1, cycles=False, **FAST), classifier=load_classifier("default"))
+    assert given.classifier["classifier"] == "default"  # an explicit classifier is kept
 
 
 def test_advice_comes_below_the_threshold_and_names_what_would_raise_it():

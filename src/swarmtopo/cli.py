@@ -246,8 +246,9 @@ def map_command(
              "together (default: 0.75,1,1.25; 1 maps one length, about three times faster: docs/accuracy.md)."),
     classifier: Optional[str] = typer.Option(
         None, "--classifier",
-        help="Betti classifier: default (tuned on the accuracy benchmark), paper-form (the paper's form trained "
-             "our way), paper (the paper's Theta*), or a JSON file."),
+        help="Betti classifier: default (tuned on the accuracy benchmark), trace (the same tuned on its logs read "
+             "as contact traces), paper-form (the paper's form trained our way), paper (the paper's Theta*), or a "
+             "JSON file. Unset: default for a log with status changes, trace for one without."),
     paper: bool = typer.Option(
         False, "--paper",
         help="Run exactly the paper's pipeline: no per-hop cost, no diffusive weights, wall following like any "
@@ -272,7 +273,7 @@ def map_command(
         hop_cost, diffusion_time, wall_follow_weight, window_length, classifier = 0.0, "none", "none", "none", "paper"
         window_scales = (1.0,)
     out_dir = out_dir or log_dir / "map"
-    model = load_classifier(classifier or "default")
+    model = load_classifier(classifier) if classifier else None  # None: the shipped one for the log
     log = read_log(log_dir)
     config = MapConfig(metric=metric, subsample=subsample, landmarks=landmarks, window=window, maxdim=maxdim,
                        seed=seed, hop_cost=hop_cost, diffusion_time=seconds_option(diffusion_time),

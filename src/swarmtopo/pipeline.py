@@ -397,7 +397,7 @@ def map_encounters(
         Pipeline options; defaults to ``MapConfig()``.
     classifier
         How Betti numbers n >= 1 are read off each region's diagram; defaults to
-        the shipped ``load_classifier("default")``.
+        the shipped one for the log (:func:`shipped_classifier_for`).
     progress
         Optional callable receiving the name of each stage (``STAGES``) as it starts.
 
@@ -408,7 +408,7 @@ def map_encounters(
         to count as a region.
     """
     config = (config or MapConfig()).validate()
-    classifier = classifier or load_classifier("default")
+    classifier = classifier or load_classifier(shipped_classifier_for(log))
     rng = np.random.default_rng(config.seed)
     say = progress or (lambda stage: None)
     timings = dict.fromkeys(STAGES, 0.0)
@@ -477,6 +477,11 @@ def map_encounters(
         counted = {n: longest_bars(chosen.diagram, n, count) for n, count in betti_region.items()}
         thresholds = classifier.length_thresholds(chosen.diagram)
         timings["classify"] += time.perf_counter() - t0
+        if config.cycles:  # the cocycles the loops are found from: the same diagram, from the backend that keeps them
+            say("cycles")
+            t0 = time.perf_counter()
+            chosen.persistence = rips_persistence(chosen.landmarks.distances, maxdim=config.maxdim, cocycles=True)
+            timings["cycles"] += time.perf_counter() - t0
         say("embedding")
         t0 = time.perf_counter()
         emb = (mds(chosen.landmarks.distances, dim=config.embed_dim, rng=rng)
@@ -548,14 +553,21 @@ def _map_window(span, sub: EncounterGraph, n_land: int | None, config: MapConfig
     timings["landmarks"] += time.perf_counter() - t0
     say("persistence")
     t0 = time.perf_counter()
-    # with loops asked for, one run that also keeps the cocycles they are found from
-    persistence = rips_persistence(land.distances, maxdim=config.maxdim, cocycles=config.cycles)
+    # the fastest backend; the window the loops are drawn from is run again with cocycles
+    persistence = rips_persistence(land.distances, maxdim=config.maxdim)
     timings["persistence"] += time.perf_counter() - t0
     t_lo, t_hi = (float(sub.event_t.min()), float(sub.event_t.max())) if span is None else span
     return WindowMap(t0=t_lo, t1=t_hi, n_events=sub.n_events, landmarks=land,
                      landmark_events=sub.representative_event()[land.nodes],
                      scales=RegionScales(knn=knn_scale, cover_radius=float(land.cover_radius)),
                      persistence=persistence)
+
+
+def shipped_classifier_for(log: EncounterLog) -> str:
+    """The shipped classifier ``map`` reads a log with: "default", fitted on logs with
+    status changes, or "trace" for a log without any (a contact trace: no wall following
+    to weigh), fitted on the same tuning cases read as encounters only."""
+    return "default" if len(log.status_t) else "trace"
 
 
 def resolve_hop_cost(log: EncounterLog, hop_cost: float | None) -> tuple[float, str]:

@@ -94,6 +94,27 @@ def stripped_log(log: EncounterLog) -> EncounterLog:
         return read_log(folder)
 
 
+CONTACT_TRACE_META_KEYS = ("format", "version", "units", "duration", "agent_count", "agent_ids")
+"""What :func:`contact_trace` keeps of ``meta.json``: what a contact trace's own folder says."""
+
+
+def contact_trace(log: EncounterLog) -> EncounterLog:
+    """The log as a real contact trace would give it: encounters only.
+
+    No status changes (so no wall following and no stops), no static agents, and of
+    ``meta.json`` only ``CONTACT_TRACE_META_KEYS``: no sensing radius r_d, no speeds, no
+    time step, so the hop cost, windows and diffusion time come from the encounters
+    themselves, as for a trace read with ``swarmtopo ingest``.
+    """
+    return EncounterLog(t=log.t, a=log.a, b=log.b, agent_ids=log.agent_ids,
+                        meta={k: v for k, v in log.meta.items() if k in CONTACT_TRACE_META_KEYS})
+
+
+INPUTS = ("log", "contact-trace")
+"""What a job's map reads (``config["map"]["input"]``, "log" when absent): the stripped
+log folder, or only its encounters (:func:`contact_trace`)."""
+
+
 def job_map_config(mapping: dict[str, Any], seed: int | None = None) -> MapConfig:
     """The ``MapConfig`` of a job's canonical ``[map]`` table ("auto" -> None, from the
     data; "none" -> inf, except a "none" wall-following weight -> None), as sweeps map:
@@ -117,7 +138,9 @@ def run_job(job: Job) -> dict[str, Any]:
 
     Streams (:meth:`Job.stream_seeds`): the arena's holes, the simulation, and the
     map's landmark start.  The map uses no picture (``embed_dim = 0``) and the
-    classifier named in ``config["map"]["classifier"]``; ``snr_h1`` is the paper's SNR
+    classifier named in ``config["map"]["classifier"]``, reading the stripped log folder or,
+    with ``config["map"]["input"] = "contact-trace"`` (``INPUTS``; set by benchmark code,
+    not a grid key), only its encounters; ``snr_h1`` is the paper's SNR
     of the union diagram in dimension 1 given the true beta_1.
 
     Raises
@@ -142,7 +165,12 @@ def run_job(job: Job) -> dict[str, Any]:
         row["t_simulate"] = time.perf_counter() - t0
         row["n_events"], row["n_agents"] = sim.log.n_events, sim.log.n_agents
         classifier = _classifier(mapping["classifier"], job.file("map.classifier"))
-        tmap = map_encounters(stripped_log(sim.log), job_map_config(mapping, seeds["map"]), classifier=classifier)
+        source = mapping.get("input", "log")
+        if source not in INPUTS:
+            raise ValueError(f"map input {source!r} is not one of {INPUTS}")
+        log = stripped_log(sim.log)
+        tmap = map_encounters(contact_trace(log) if source == "contact-trace" else log,
+                              job_map_config(mapping, seeds["map"]), classifier=classifier)
     except SwarmtopoError as exc:
         row["error"] = " ".join(str(exc).split())
     else:

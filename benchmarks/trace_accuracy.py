@@ -1,0 +1,94 @@
+"""The accuracy benchmark's reporting cases mapped as contact traces: encounters only.
+
+A real contact trace has no status changes (so no wall following and no stops), no
+sensing radius and no speeds: the default pipeline then takes its hop cost, windows and
+diffusion time from the encounters themselves (docs/accuracy.md, "Real traces").  This
+maps the benchmark's reporting cases that way (``experiments.sweep.contact_trace``) with
+the default pipeline, as a Dask sweep into a resumable store.  Read by the shipped
+``trace`` classifier (what ``map`` uses for a log without status changes, fitted on
+tuning cases only) or by any shipped classifiers named, it prints exact (beta_0,
+beta_1) per cell with Wilson 95 % intervals, the held-out family, and the Brier score
+of the beta_1 confidence.  Given the store of a ``swarmtopo bench accuracy`` run of the
+same cases (``--compare``), it prints the full log folders' figures beside them and the
+maps each reading alone gets right.
+
+    python benchmarks/trace_accuracy.py --store trace.duckdb [--compare full.duckdb] [--quick]
+                                        [--classifier trace default]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+from swarmtopo.classify import load_classifier
+from swarmtopo.experiments.accuracy import (CELLS, PIPELINES, QUICK_PER_CELL, REPORTING_PER_CELL, Rate,
+                                            accuracy_table, outcomes, reliability, reporting_jobs)
+from swarmtopo.experiments.store import read_jobs
+from swarmtopo.experiments.sweep import run_sweep
+
+TRACE = {**PIPELINES["default"], "input": "contact-trace"}
+"""The default pipeline reading only the encounters of each case's log folder."""
+
+
+def _rate(rate: Rate) -> str:
+    lo, hi = rate.interval
+    return f"{rate.right}/{rate.total} = {rate.rate:.2f} [{lo:.2f}, {hi:.2f}]" if rate.total else "-"
+
+
+def _records(store: str, keys: set[str], classifier: str) -> list[dict]:
+    """The stored maps of these jobs read by a shipped classifier (whatever the job ran)."""
+    rows = [row for row in read_jobs(store) if row["key"] in keys]
+    return outcomes(rows, load_classifier(classifier))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--store", required=True, help="DuckDB store of this benchmark (resumable)")
+    parser.add_argument("--compare", help="store of `swarmtopo bench accuracy` on the same cases")
+    parser.add_argument("--quick", action="store_true", help=f"{QUICK_PER_CELL} cases per cell, "
+                                                             f"not {REPORTING_PER_CELL}")
+    parser.add_argument("--workers", type=int, help="local Dask workers (default: one per core)")
+    parser.add_argument("--classifier", nargs="+", default=["trace"],
+                        help="shipped classifiers to read the contact traces' maps with (default: trace, what "
+                             "`map` uses for a log without status changes)")
+    args = parser.parse_args()
+    per_cell = QUICK_PER_CELL if args.quick else REPORTING_PER_CELL
+    jobs = reporting_jobs(per_cell, pipelines={"contact-trace": TRACE})
+    start = time.perf_counter()
+    summary = run_sweep(jobs, args.store, workers=args.workers)
+    print(f"{len(jobs)} contact-trace maps ({per_cell} per cell), {summary.run} run in "
+          f"{(time.perf_counter() - start) / 60:.1f} min on {summary.workers} Dask workers")
+    keys = {job.key for job in jobs}
+    columns = {f"contact trace, {name} classifier": _records(args.store, keys, name) for name in args.classifier}
+    if args.compare:
+        full_keys = {job.key for job in reporting_jobs(per_cell, pipelines={"default": PIPELINES["default"]})}
+        columns["full log folder, default classifier (docs/accuracy.md)"] = _records(args.compare, full_keys, "default")
+    tables = {name: accuracy_table(records) for name, records in columns.items()}
+    print("\n| cell | " + " | ".join(columns) + " |\n|---|" + "---|" * len(columns))
+    for cell in CELLS:
+        print(f"| {cell.name} | " + " | ".join(_rate(t["cells"][cell.name]) for t in tables.values()) + " |")
+    for key, label in (("overall", "**all reporting cases**"), ("held_out", "held-out family (L-shaped holes)")):
+        print(f"| {label} | " + " | ".join(_rate(t[key]) for t in tables.values()) + " |")
+    for name, records in columns.items():
+        rel = reliability(records, 1)
+        too_many = sum(r["est_betti1"] is not None and r["est_betti1"] > r["true_betti1"] for r in records)
+        too_few = sum(r["est_betti1"] is not None and r["est_betti1"] < r["true_betti1"] for r in records)
+        failed = sum(r["error"] is not None for r in records)
+        print(f"\n{name}: beta_1 too many {too_many}, too few {too_few}, not mapped {failed}; "
+              f"Brier {rel['brier']:.4f} (constant {rel['brier_constant']:.4f}); "
+              f"mean {sum(r['seconds'] for r in records) / len(records):.2f} s per map")
+        print("  reliability (confidence bin: maps, mean confidence said, fraction right): " + "; ".join(
+            f"{b['low']:g}-{b['high']:g}: {b['maps']}, {b['mean_confidence']:.3f}, {b['fraction_right']:.3f}"
+            for b in rel["bins"]))
+    if args.compare:
+        *traces, full = columns.values()
+        full_right = {(r["cell"], r["index"]) for r in full if r["right"]}
+        for name, records in zip(columns, traces):
+            trace_right = {(r["cell"], r["index"]) for r in records if r["right"]}
+            print(f"{name}: right only as a contact trace {len(trace_right - full_right)}, "
+                  f"only with the full log folder {len(full_right - trace_right)}")
+
+
+if __name__ == "__main__":
+    main()
