@@ -129,7 +129,11 @@ def main() -> None:
             "tuning_maps": chosen["total"], "tuning_exact": chosen["right"] / chosen["total"], "swarmtopo": __version__})
         model.save(ROOT / "src" / "swarmtopo" / "data" / f"classifier-{name}.json")
     job_minutes = sum(r["t_total"] for candidate_rows in rows.values() for r in candidate_rows) / 60
-    _write_doc(results, (CHOSEN, CHOSEN_TRACE), args, time.perf_counter() - started, summary, job_minutes)
+    trace, default_thresholds = results[CHOSEN_TRACE], results[CHOSEN]["fit"].thresholds
+    transfer = exact(trace["maps"], default_thresholds, CHOSEN_TRACE[1])
+    print(f"contact traces read with the default's thresholds {default_thresholds}: {transfer.sum()}/{trace['total']}")
+    _write_doc(results, (CHOSEN, CHOSEN_TRACE), args, time.perf_counter() - started, summary, job_minutes,
+               transfer=(default_thresholds, int(transfer.sum()), trace["total"]))
     print(f"chosen: {CHOSEN[0]}, {CHOSEN[1]} pooling; for contact traces: {CHOSEN_TRACE[0]}, {CHOSEN_TRACE[1]} "
           "pooling; wrote classifier-default.json, classifier-trace.json and docs/tuning.md")
 
@@ -143,7 +147,7 @@ def _rate(flags) -> tuple[int, int]:
     return int(sum(flags)), len(flags)
 
 
-def _write_doc(results, chosen, args, seconds, summary, job_minutes) -> None:
+def _write_doc(results, chosen, args, seconds, summary, job_minutes, transfer) -> None:
     lines = [
         "# Tuning the default pipeline",
         "",
@@ -179,6 +183,9 @@ def _write_doc(results, chosen, args, seconds, summary, job_minutes) -> None:
                      f"{r['right'] / r['total']:.2f} | {r['cv']}/{r['total']} = {r['cv'] / r['total']:.2f} | "
                      f"{r['paper_form']}/{r['total']} = {r['paper_form'] / r['total']:.2f} | "
                      f"{worst[0]}: {worst[1][0]}/{worst[1][1]} | {r['seconds']:.2f} |")
+    th, right, total = transfer
+    lines += ["", f"The contact-trace candidate's maps read with the default's thresholds (q_1 = {th.q:g}, "
+                  f"tau_1 = {th.tau:g}) instead of their own: {right}/{total} = {right / total:.2f} exact."]
     lines += ["", "Exact maps per cell, every candidate and pooling (ratio classifier, its fitted thresholds):", "",
               "| cell | " + " | ".join(f"{name}, {pooling}" for name, pooling in ranked) + " |",
               "|---" * (len(ranked) + 1) + "|"]
