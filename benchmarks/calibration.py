@@ -28,7 +28,7 @@ from sklearn.model_selection import KFold, cross_val_predict
 
 from swarmtopo.experiments.accuracy import cell_of, reliability
 from swarmtopo.experiments.store import read_jobs
-from swarmtopo.experiments.sweep import job_map_config
+from swarmtopo.experiments.sweep import job_map_config, map_input
 from swarmtopo.experiments.tuning import PIPELINE_FIELDS, cross_fitted_features, maps_from_rows
 from swarmtopo.pipeline import MapConfig
 from swarmtopo.ratio import CONFIDENCE_FEATURES, confidence_design, confidence_model
@@ -42,10 +42,11 @@ COLUMNS = ("key", "config", "replicate", "diagrams", "error", "est_betti0", "tru
 
 
 def default_maps(store: str):
-    """The tuning maps of the pipeline whose options are MapConfig's defaults, in job order."""
+    """The tuning maps of the pipeline whose options are MapConfig's defaults, reading the
+    whole log folder (not its contact trace), in job order."""
     defaults = MapConfig()
-    rows = [r for r in read_jobs(store, columns=COLUMNS)
-            if all(getattr(job_map_config(r["config"]["map"]), k) == getattr(defaults, k) for k in PIPELINE_FIELDS)]
+    rows = [r for r in read_jobs(store, columns=COLUMNS) if map_input(r["config"]["map"]) == "log"
+            and all(getattr(job_map_config(r["config"]["map"]), k) == getattr(defaults, k) for k in PIPELINE_FIELDS)]
     rows.sort(key=lambda r: (r["replicate"], cell_of(r["config"])))
     return maps_from_rows(rows, cell_of)
 

@@ -28,17 +28,20 @@ import argparse
 
 from swarmtopo.classify import load_classifier
 from swarmtopo.ratio import RatioClassifier, RatioThresholds
-from swarmtopo.experiments.accuracy import CELLS, PIPELINES, accuracy_table, outcomes, reliability
+from swarmtopo.experiments.accuracy import CELLS, PIPELINES, accuracy_table, beta1_misses, outcomes, reliability
 from swarmtopo.experiments.store import read_jobs
+from swarmtopo.experiments.sweep import map_input
 
 COLUMNS = ("key", "config", "replicate", "diagrams", "error", "est_betti0", "true_betti0", "true_betti1", "t_total")
 """The columns the verdict needs (``accuracy.outcomes``)."""
 
 
 def default_rows(store: str) -> list[dict]:
-    """The store's rows of the default pipeline (its ``classifier`` is "default"), sorted by key."""
+    """The store's rows of the default pipeline (its ``classifier`` is "default", reading the
+    whole log folder), sorted by key."""
     return [row for row in read_jobs(store, columns=COLUMNS)
-            if row["config"]["map"].get("classifier") == PIPELINES["default"]["classifier"]]
+            if row["config"]["map"].get("classifier") == PIPELINES["default"]["classifier"]
+            and map_input(row["config"]["map"]) == "log"]
 
 
 def main() -> None:
@@ -79,10 +82,9 @@ def _misses(records: list[dict]) -> str:
     parts = []
     for group in dict.fromkeys(_group({"cell": cell.name}) for cell in CELLS):
         mine = [r for r in records if _group(r) == group]
-        wrong = [r for r in mine if not r["right"] and r["est_betti1"] is not None]
+        too_many, too_few = beta1_misses(mine)
         held = [r for r in mine if r["held_out"]]
-        parts.append(f"{group}: {sum(r['est_betti1'] > r['true_betti1'] for r in wrong)} too many / "
-                     f"{sum(r['est_betti1'] < r['true_betti1'] for r in wrong)} too few holes, held-out "
+        parts.append(f"{group}: {too_many} too many / {too_few} too few holes, held-out "
                      f"{sum(r['right'] for r in held)}/{len(held)}")
     confidences = sorted(r["confidence_betti1"] for r in records
                          if not r["right"] and r["confidence_betti1"] is not None)

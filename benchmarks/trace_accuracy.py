@@ -22,8 +22,8 @@ import argparse
 import time
 
 from swarmtopo.classify import load_classifier
-from swarmtopo.experiments.accuracy import (CELLS, PIPELINES, QUICK_PER_CELL, REPORTING_PER_CELL, Rate,
-                                            accuracy_table, outcomes, reliability, reporting_jobs)
+from swarmtopo.experiments.accuracy import (CELLS, PIPELINES, QUICK_PER_CELL, REPORTING_PER_CELL, accuracy_table,
+                                            beta1_misses, outcomes, rate_text, reliability, reporting_jobs)
 from swarmtopo.experiments.store import read_jobs
 from swarmtopo.experiments.sweep import run_sweep
 
@@ -31,15 +31,10 @@ TRACE = {**PIPELINES["default"], "input": "contact-trace"}
 """The default pipeline reading only the encounters of each case's log folder."""
 
 
-def _rate(rate: Rate) -> str:
-    lo, hi = rate.interval
-    return f"{rate.right}/{rate.total} = {rate.rate:.2f} [{lo:.2f}, {hi:.2f}]" if rate.total else "-"
-
-
-def _records(store: str, keys: set[str], classifier: str) -> list[dict]:
-    """The stored maps of these jobs read by a shipped classifier (whatever the job ran)."""
-    rows = [row for row in read_jobs(store) if row["key"] in keys]
-    return outcomes(rows, load_classifier(classifier))
+def _rows(store: str, jobs) -> list[dict]:
+    """The store's rows of these jobs."""
+    keys = {job.key for job in jobs}
+    return [row for row in read_jobs(store) if row["key"] in keys]
 
 
 def main() -> None:
@@ -59,21 +54,21 @@ def main() -> None:
     summary = run_sweep(jobs, args.store, workers=args.workers)
     print(f"{len(jobs)} contact-trace maps ({per_cell} per cell), {summary.run} run in "
           f"{(time.perf_counter() - start) / 60:.1f} min on {summary.workers} Dask workers")
-    keys = {job.key for job in jobs}
-    columns = {f"contact trace, {name} classifier": _records(args.store, keys, name) for name in args.classifier}
+    rows = _rows(args.store, jobs)  # each job's stored diagrams, read by each classifier (whatever the job ran)
+    columns = {f"contact trace, {name} classifier": outcomes(rows, load_classifier(name)) for name in args.classifier}
     if args.compare:
-        full_keys = {job.key for job in reporting_jobs(per_cell, pipelines={"default": PIPELINES["default"]})}
-        columns["full log folder, default classifier (docs/accuracy.md)"] = _records(args.compare, full_keys, "default")
+        full = _rows(args.compare, reporting_jobs(per_cell, pipelines={"default": PIPELINES["default"]}))
+        columns["full log folder, default classifier (docs/accuracy.md)"] = outcomes(full, load_classifier("default"))
     tables = {name: accuracy_table(records) for name, records in columns.items()}
     print("\n| cell | " + " | ".join(columns) + " |\n|---|" + "---|" * len(columns))
     for cell in CELLS:
-        print(f"| {cell.name} | " + " | ".join(_rate(t["cells"][cell.name]) for t in tables.values()) + " |")
+        print(f"| {cell.name} | " + " | ".join(rate_text(t["cells"][cell.name].to_json()) for t in tables.values())
+              + " |")
     for key, label in (("overall", "**all reporting cases**"), ("held_out", "held-out family (L-shaped holes)")):
-        print(f"| {label} | " + " | ".join(_rate(t[key]) for t in tables.values()) + " |")
+        print(f"| {label} | " + " | ".join(rate_text(t[key].to_json()) for t in tables.values()) + " |")
     for name, records in columns.items():
         rel = reliability(records, 1)
-        too_many = sum(r["est_betti1"] is not None and r["est_betti1"] > r["true_betti1"] for r in records)
-        too_few = sum(r["est_betti1"] is not None and r["est_betti1"] < r["true_betti1"] for r in records)
+        too_many, too_few = beta1_misses(records)
         failed = sum(r["error"] is not None for r in records)
         print(f"\n{name}: beta_1 too many {too_many}, too few {too_few}, not mapped {failed}; "
               f"Brier {rel['brier']:.4f} (constant {rel['brier_constant']:.4f}); "

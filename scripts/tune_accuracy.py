@@ -49,12 +49,12 @@ ROOT = Path(__file__).resolve().parent.parent
 
 OURS = {"hop_cost": "auto", "diffusion_time": "auto", "wall_follow_weight": 2.0, "window_length": "auto",
         "window_encounters": 20.0, "window_step": "auto"}
+THREE_LENGTHS = {**OURS, "window_scales": [0.75, 1.0, 1.25]}
 CANDIDATES = {
-    "h auto, diffusive, wall following x 2, windows of 15, 20 and 25 encounters per agent": {
-        **OURS, "window_scales": [0.75, 1.0, 1.25]},
+    "h auto, diffusive, wall following x 2, windows of 15, 20 and 25 encounters per agent": THREE_LENGTHS,
     "the same, windows of 20 encounters per agent only": {**OURS, "window_scales": [1.0]},
     "the first, reading a contact trace (encounters only: h from the data, no wall following)": {
-        **OURS, "window_scales": [0.75, 1.0, 1.25], "input": "contact-trace"},
+        **THREE_LENGTHS, "input": "contact-trace"},
     "h 0, no diffusive weights, whole log (the paper's metric)": {
         "hop_cost": 0.0, "diffusion_time": "none", "wall_follow_weight": "none", "window_length": "none"},
 }

@@ -477,11 +477,6 @@ def map_encounters(
         counted = {n: longest_bars(chosen.diagram, n, count) for n, count in betti_region.items()}
         thresholds = classifier.length_thresholds(chosen.diagram)
         timings["classify"] += time.perf_counter() - t0
-        if config.cycles:  # the cocycles the loops are found from: the same diagram, from the backend that keeps them
-            say("cycles")
-            t0 = time.perf_counter()
-            chosen.persistence = rips_persistence(chosen.landmarks.distances, maxdim=config.maxdim, cocycles=True)
-            timings["cycles"] += time.perf_counter() - t0
         say("embedding")
         t0 = time.perf_counter()
         emb = (mds(chosen.landmarks.distances, dim=config.embed_dim, rng=rng)
@@ -508,6 +503,9 @@ def map_encounters(
         if config.cycles:
             say("cycles")
             t0 = time.perf_counter()
+            # the cocycles the loops are found from: the same diagram, from the backend that keeps them
+            chosen.persistence = rips_persistence(chosen.landmarks.distances, maxdim=config.maxdim, cocycles=True)
+            regions[-1].diagram = chosen.diagram
             regions[-1].cycles = region_cycles(regions[-1], chosen.persistence)
             timings["cycles"] += time.perf_counter() - t0
     betti: dict[int, int | None] = {0: len(regions)}

@@ -253,6 +253,21 @@ def accuracy_table(records: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
+def beta1_misses(records: list[dict[str, Any]]) -> tuple[int, int]:
+    """(too many, too few): the mapped records whose beta_1 is above / below the truth."""
+    mapped = [r for r in records if r["est_betti1"] is not None]
+    return (sum(r["est_betti1"] > r["true_betti1"] for r in mapped),
+            sum(r["est_betti1"] < r["true_betti1"] for r in mapped))
+
+
+def rate_text(rate: dict[str, Any]) -> str:
+    """A rate as a table cell, "k/n = rate [Wilson 95 %]" ("-" for none); ``Rate.to_json`` form."""
+    if not rate["total"]:
+        return "-"
+    lo, hi = rate["wilson95"]
+    return f"{rate['right']}/{rate['total']} = {rate['rate']:.2f} [{lo:.2f}, {hi:.2f}]"
+
+
 RELIABILITY_EDGES = (0.0, 0.5, 0.7, 0.8, 0.9, 0.95, 0.99, 1.0)
 """Confidence bins of the reliability table: narrow near 1, where most maps are reported."""
 
@@ -338,12 +353,6 @@ def markdown(summary: dict[str, Any], command: str) -> str:
     """The benchmark's tables as Markdown (what docs/accuracy.md quotes)."""
     names = list(summary["pipelines"])
 
-    def cell(rate: dict[str, Any]) -> str:
-        if not rate["total"]:
-            return "-"
-        lo, hi = rate["wilson95"]
-        return f"{rate['right']}/{rate['total']} = {rate['rate']:.2f} [{lo:.2f}, {hi:.2f}]"
-
     lines = [f"Suite `{summary['suite']}`, {summary['cases_per_cell']} reporting cases per cell, "
              f"{summary['maps']} maps. Command: `{command}`; {summary['jobs_run']} jobs run in "
              f"{summary['seconds'] / 60:.1f} min on {summary['workers']} Dask workers.", "",
@@ -351,13 +360,11 @@ def markdown(summary: dict[str, Any], command: str) -> str:
              "| cell | " + " | ".join(PIPELINE_LABELS.get(n, n) for n in names) + " |",
              "|---|" + "---|" * len(names)]
     for c in CELLS:
-        lines.append(f"| {c.name} | " + " | ".join(cell(summary["pipelines"][n]["table"]["cells"][c.name])
+        lines.append(f"| {c.name} | " + " | ".join(rate_text(summary["pipelines"][n]["table"]["cells"][c.name])
                                                 for n in names) + " |")
     for key, label in (("overall", "**all reporting cases**"), ("seen_families", "families seen in tuning"),
-                       (None, None), ("held_out", f"held-out family ({HELD_OUT_FAMILY}-shaped holes)")):
-        if key is None:
-            continue
-        lines.append(f"| {label} | " + " | ".join(cell(summary["pipelines"][n]["table"][key]) for n in names) + " |")
+                       ("held_out", f"held-out family ({HELD_OUT_FAMILY}-shaped holes)")):
+        lines.append(f"| {label} | " + " | ".join(rate_text(summary["pipelines"][n]["table"][key]) for n in names) + " |")
     lines.append("| mean seconds per map | " + " | ".join(
         f"{summary['pipelines'][n]['mean_seconds']:.2f}" if summary["pipelines"][n]["mean_seconds"] else "-"
         for n in names) + " |")

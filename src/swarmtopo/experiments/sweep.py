@@ -115,6 +115,14 @@ INPUTS = ("log", "contact-trace")
 log folder, or only its encounters (:func:`contact_trace`)."""
 
 
+def map_input(mapping: dict[str, Any]) -> str:
+    """What a job's ``[map]`` table says its map reads (``INPUTS``; "log" when absent)."""
+    source = mapping.get("input", "log")
+    if source not in INPUTS:
+        raise ValueError(f"map input {source!r} is not one of {INPUTS}")
+    return source
+
+
 def job_map_config(mapping: dict[str, Any], seed: int | None = None) -> MapConfig:
     """The ``MapConfig`` of a job's canonical ``[map]`` table ("auto" -> None, from the
     data; "none" -> inf, except a "none" wall-following weight -> None), as sweeps map:
@@ -165,11 +173,8 @@ def run_job(job: Job) -> dict[str, Any]:
         row["t_simulate"] = time.perf_counter() - t0
         row["n_events"], row["n_agents"] = sim.log.n_events, sim.log.n_agents
         classifier = _classifier(mapping["classifier"], job.file("map.classifier"))
-        source = mapping.get("input", "log")
-        if source not in INPUTS:
-            raise ValueError(f"map input {source!r} is not one of {INPUTS}")
         log = stripped_log(sim.log)
-        tmap = map_encounters(contact_trace(log) if source == "contact-trace" else log,
+        tmap = map_encounters(contact_trace(log) if map_input(mapping) == "contact-trace" else log,
                               job_map_config(mapping, seeds["map"]), classifier=classifier)
     except SwarmtopoError as exc:
         row["error"] = " ".join(str(exc).split())
