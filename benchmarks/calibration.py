@@ -41,11 +41,11 @@ FEATURE_SETS = {
 COLUMNS = ("key", "config", "replicate", "diagrams", "error", "est_betti0", "true_betti0", "true_betti1")
 
 
-def default_maps(store: str):
+def default_maps(store: str, reading: str = "log"):
     """The tuning maps of the pipeline whose options are MapConfig's defaults, reading the
-    whole log folder (not its contact trace), in job order."""
+    whole log folder (``reading`` "log") or its contact trace ("contact-trace"), in job order."""
     defaults = MapConfig()
-    rows = [r for r in read_jobs(store, columns=COLUMNS) if map_input(r["config"]["map"]) == "log"
+    rows = [r for r in read_jobs(store, columns=COLUMNS) if map_input(r["config"]["map"]) == reading
             and all(getattr(job_map_config(r["config"]["map"]), k) == getattr(defaults, k) for k in PIPELINE_FIELDS)]
     rows.sort(key=lambda r: (r["replicate"], cell_of(r["config"])))
     return maps_from_rows(rows, cell_of)

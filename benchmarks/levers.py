@@ -46,6 +46,10 @@ diffusion time, wall following x 2):
 * ``wall-C`` -- an agent's wall-following time weighs C per second outside the
   diffusive weights (``MapConfig.wall_follow_weight``; the default is C = 2);
   ``wall-none`` charges it like any other time.
+* ``pad-F`` -- each window's graph built on the window widened by F x its length on
+  both sides, landmarks drawn (maxmin) only among the nodes inside the window: paths may
+  leave the window in time, so the events at its edges are no longer the ends of cut
+  chains, which maxmin otherwise favours as outliers.
 * ``smooth-HOW-K`` -- Vietoris-Rips on neighbourhood-averaged landmark distances:
   d~(l_i, l_j) = (A_ij + A_ji) / 2 with A_ij the mean (HOW = ``mean``) or median
   (``median``) of d(l_i, y) over the K nodes y nearest l_j, or that mean minus their
@@ -99,6 +103,7 @@ from scipy import sparse
 from scipy.sparse.csgraph import dijkstra, minimum_spanning_tree, shortest_path
 
 from swarmtopo import graph as G
+from swarmtopo import landmarks as L
 from swarmtopo import pipeline as P
 from swarmtopo.embed import mds
 from swarmtopo.errors import SwarmtopoError
@@ -384,6 +389,42 @@ def _trajectory(log, seed, factor):
         P._map_window = original
 
 
+def _padded(log, seed, factor):
+    """Each window's graph built on the window widened by ``factor`` x its length on both
+    sides, landmarks drawn only among the nodes inside the window: paths may leave the
+    window in time, so the events at its edges are not outliers of a cut chain."""
+    original_build, original_map, original_subsample = P.build_graph, P._map_window, P._subsample
+    current = {"span": None}
+
+    def build(log_, metric, *, window=None, **options):
+        if window is not None:
+            pad = factor * (window[1] - window[0])
+            window = (window[0] - pad, window[1] + pad)
+        return original_build(log_, metric, window=window, **options)
+
+    def map_window(span, sub, n_land, config, rng, timings, say):
+        current["span"] = span
+        return original_map(span, sub, n_land, config, rng, timings, say)
+
+    def subsample(graph, config, n_landmarks, rng):
+        span = current["span"]
+        if span is None:
+            return original_subsample(graph, config, n_landmarks, rng)
+        node_t = np.full(graph.n_nodes, np.inf)
+        np.minimum.at(node_t, graph.node_of_event, graph.event_t)
+        inside = (node_t >= span[0]) & (node_t <= span[1])
+        arrays = L._GraphArrays.of(graph)
+        start = L._random_candidate(inside, np.random.default_rng(rng))
+        nodes, radii = L._pick(arrays, inside, n_landmarks, start)
+        return L._result(arrays, nodes, radii, "maxmin", {"start": start}, L._quiet)
+
+    P.build_graph, P._map_window, P._subsample = build, map_window, subsample
+    try:
+        return _windows_of(log, seed)
+    finally:
+        P.build_graph, P._map_window, P._subsample = original_build, original_map, original_subsample
+
+
 def _override(text):
     """The variant ``FIELD=VALUE``: MapConfig(FIELD=VALUE), VALUE read as the field's default's type
     (a tuple from comma-separated numbers: ``window_scales=0.75,1``)."""
@@ -414,6 +455,8 @@ def _variant(name):
         return lambda log, seed: _windows_of(log, seed + int(name.split("+", 1)[1]))
     if name.startswith("wall-"):
         return lambda log, seed: _windows_of(log, seed, wall_follow_weight=P.wall_follow_option(name.split("-", 1)[1]))
+    if name.startswith("pad-"):
+        return lambda log, seed: _padded(log, seed, float(name.split("-", 1)[1]))
     if name.startswith("smooth-"):
         _, how, k = name.split("-")
         return lambda log, seed: _smooth(log, seed, how, int(k))
@@ -494,7 +537,7 @@ def main() -> None:
     parser.add_argument("--per-cell", type=int, default=12)
     parser.add_argument("--variants", nargs="+", default=["default", "20s", "whole", "quarter", "draws", "switch"],
                         help=f"{', '.join(sorted(VARIANTS))}, diffusive-C, switch-C, log-C, wall-C, wall-none, "
-                             "smooth-HOW-K, paths-C, dtm-K, mds-D, mix-K1-K2[-whole], draws-K[/VARIANT], trace/VARIANT, seed+D, "
+                             "smooth-HOW-K, pad-F, paths-C, dtm-K, mds-D, mix-K1-K2[-whole], draws-K[/VARIANT], trace/VARIANT, seed+D, "
                              "tcorr-S or "
                              "FIELD=VALUE; "
                              "VARIANT@D: with the landmark draw of seed + D")

@@ -53,3 +53,16 @@ def test_draws_of_a_variant_pool_that_variants_windows_at_consecutive_seeds():
     expected = [a + b for a, b in zip(parts[0][0], parts[1][0])]
     assert [[d.lengths(1).tolist() for d in r] for r in regions] == \
         [[d.lengths(1).tolist() for d in r] for r in expected]
+
+
+def test_padding_by_nothing_is_the_default_and_restores_the_pipeline():
+    """``pad-0``: the window's own graph, every node a candidate, the same first pick: the default's diagrams."""
+    log = simulate(random_arena(2, rng=4), 80, 12.0, rng=4).log
+    originals = (levers.P.build_graph, levers.P._map_window, levers.P._subsample)
+    padded, beta0 = levers._variant("pad-0")(log, 9)
+    default, default_beta0 = levers._windows_of(log, 9)
+    assert (levers.P.build_graph, levers.P._map_window, levers.P._subsample) == originals
+    assert beta0 == default_beta0
+    assert [[d.lengths(1).tolist() for d in r] for r in padded] == [[d.lengths(1).tolist() for d in r] for r in default]
+    wider, _ = levers._variant("pad-0.5")(log, 9)
+    assert [len(r) for r in wider] == [len(r) for r in default]  # the same windows, mapped from wider graphs
