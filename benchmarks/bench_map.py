@@ -4,7 +4,8 @@ Part 1 (10^6 events, ``--quick``: 10^5): ``swarmtopo.pipeline.map_encounters`` o
 simulated two-hole log (``_data.simulated_log``: 2,000 agents at the paper's density,
 10 % static) with ``MapConfig(metric, subsample, landmarks=500, maxdim=1,
 embed_dim=0)`` for the three subsamplers, on the plain and the hybrid metric (the
-pipeline's default).  One run each, after a warm-up that loads the numba kernels.
+pipeline's default); every other option is the default, so the windows mapped are at
+most ``MapConfig.max_windows`` (``--max-windows none``: every window).  One run each, after a warm-up that loads the numba kernels.
 Wall time split as ``TopologicalMap.timings`` reports it (graph incl. components /
 landmarks incl. the Betti rule's k-NN scale / persistence; "other" is the rest:
 region bookkeeping, Betti rule), total
@@ -20,7 +21,7 @@ start, medians of 3, same landmarks and distances asserted.  The graph and the
 persistence stages are the same for both, so they are left out.  Targets: >= 20x
 faster, >= 50x less memory (peak RSS above the level before the call).
 
-    python benchmarks/bench_map.py [--quick] [--subsample maxmin ...]
+    python benchmarks/bench_map.py [--quick] [--subsample maxmin ...] [--max-windows 48|none]
 
 ``--subsample`` times only the named subsamplers in part 1 (each row costs minutes at
 10^6 events).
@@ -47,8 +48,9 @@ TIME_LIMIT = {"maxmin": 60.0, "knn": 120.0, "probabilistic": 120.0}
 MEMORY_LIMIT = 4 * 2**30
 
 
-def config(metric, subsample) -> MapConfig:
-    return MapConfig(metric=metric, subsample=subsample, landmarks=N_LANDMARKS, maxdim=1, embed_dim=0, seed=0)
+def config(metric, subsample, max_windows=MapConfig.max_windows) -> MapConfig:
+    return MapConfig(metric=metric, subsample=subsample, landmarks=N_LANDMARKS, maxdim=1, embed_dim=0, seed=0,
+                     max_windows=max_windows)
 
 
 def warm_up():
@@ -59,21 +61,22 @@ def warm_up():
             map_encounters(log, config(metric, subsample))
 
 
-def whole_map(n_events, subsamplers=SUBSAMPLERS):
+def whole_map(n_events, subsamplers=SUBSAMPLERS, max_windows=MapConfig.max_windows):
     log = simulated_log(n_events)
     print(f"\n## map_encounters at {log.n_events:,} events ({log.n_agents} agents, {log.duration:.0f} s, "
           f"{len(log.static_agent)} static, 2 holes), L = {N_LANDMARKS}, H0 + H1, one run each\n")
-    print("| metric | subsample | graph s | landmarks s | persistence s | other s | total s | CPU s | "
+    print("| metric | subsample | windows | graph s | landmarks s | persistence s | other s | total s | CPU s | "
           "peak MB above baseline | beta_0, beta_1 | target | met |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for metric in METRICS:
         for subsample in subsamplers:
-            result, wall, peak, cpu = run_measured(lambda: map_encounters(log, config(metric, subsample)))
+            result, wall, peak, cpu = run_measured(lambda: map_encounters(log, config(metric, subsample, max_windows)))
             stage = result.timings
             other = wall - stage["graph"] - stage["landmarks"] - stage["persistence"]
             limit = TIME_LIMIT[subsample]
             met = wall < limit and peak < MEMORY_LIMIT
-            print(f"| {metric} | {subsample} | {stage['graph']:.2f} | {stage['landmarks']:.2f} | "
+            windows = sum(len(r.windows) for r in result.regions)
+            print(f"| {metric} | {subsample} | {windows} | {stage['graph']:.2f} | {stage['landmarks']:.2f} | "
                   f"{stage['persistence']:.2f} | {other:.2f} | {wall:.1f} | {cpu:.1f} | {peak / 2**20:.0f} | "
                   f"{result.betti[0]}, {result.betti[1]} | < {limit:.0f} s, < 4 GB | {'yes' if met else 'NO'} |",
                   flush=True)
@@ -98,10 +101,14 @@ def main():
     parser.add_argument("--quick", action="store_true", help="10^5 events instead of 10^6")
     parser.add_argument("--subsample", nargs="+", choices=SUBSAMPLERS, default=list(SUBSAMPLERS),
                         help="subsamplers to time in part 1 (default: all)")
+    parser.add_argument("--max-windows", default=str(MapConfig.max_windows),
+                        help=f"cap of the windows mapped in part 1 (default {MapConfig.max_windows}, the pipeline's; "
+                             "'none': every window)")
     args = parser.parse_args()
+    max_windows = None if args.max_windows == "none" else int(args.max_windows)
     print(f"machine: {machine()}; {numba.get_num_threads()} numba threads; swarmtopo {revision()}")
     warm_up()
-    whole_map(10**5 if args.quick else 10**6, args.subsample)
+    whole_map(10**5 if args.quick else 10**6, args.subsample, max_windows)
     against_dense(10**4)
     print(f"\nload average after: {os.getloadavg()[0]:.1f}")
 

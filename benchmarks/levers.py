@@ -8,7 +8,8 @@ best.  Printed per variant and per way of pooling the windows (mean scores, as t
 shipped classifier, and the lower median of the windows' counts, as before): fitted
 exact (beta_0, beta_1), the 4-fold cross-validated count (thresholds fitted without
 each quarter), per-cell counts, counts per hole family (the family of a case's holes;
-"no hole" for none) and seconds per map.
+"no hole" for none) and seconds per map; then the exact count and per-cell counts when
+the maps are read by the shipped ``default`` classifier, as ``swarmtopo map`` reads them.
 
 Variants (all: hybrid metric, maxmin, automatic landmarks, h = r_d / v_c, automatic
 diffusion time, wall following x 2):
@@ -64,6 +65,11 @@ diffusion time, wall following x 2):
   where few encounters happen enter late.
 * ``mds-D`` -- Vietoris-Rips on the landmarks' classical MDS coordinates in R^D (the
   projection on the top D eigenvectors as a denoiser) instead of their metric.
+* ``static-F`` -- the case simulated with a fraction F of its agents static from the
+  start (placed at random like the rest, then never moving; the log's ``meta.json``
+  lists them, so the hybrid metric links all of a static agent's encounters),
+  ``static-F/VARIANT`` any variant so: what a deployment gains by parking some of its
+  agents, at the same swarm size.
 * ``FIELD=VALUE`` -- ``MapConfig(FIELD=VALUE)`` (e.g. ``subsample=knn``, ``metric=plain``).
 * ``log-C`` -- chain gaps compressed logarithmically instead, tau ln(1 + w / tau), with
   tau = C x the mean time between an agent's encounters.
@@ -106,6 +112,7 @@ from swarmtopo import graph as G
 from swarmtopo import landmarks as L
 from swarmtopo import pipeline as P
 from swarmtopo.embed import mds
+from swarmtopo.classify import load_classifier
 from swarmtopo.errors import SwarmtopoError
 from swarmtopo.experiments.accuracy import CELLS, case, tuning_session
 from swarmtopo.experiments.grid import case_streams
@@ -495,6 +502,9 @@ def _dense(log, seed):
         P.AUTO_COVER_FACTOR = original
 
 
+SHIPPED = load_classifier("default")
+"""The classifier ``map`` reads a log with status changes with: each variant's maps are also read by it."""
+
 VARIANTS = {
     "default": lambda log, seed: _windows_of(log, seed),
     "20s": lambda log, seed: _windows_of(log, seed, window_length=20.0),
@@ -513,6 +523,14 @@ VARIANTS = {
 }
 
 
+def _static_share(name):
+    """(static fraction, variant) of ``static-F[/VARIANT]`` (the default without ``/``), else (0, name)."""
+    if not name.startswith("static-"):
+        return 0.0, name
+    share, _, inner = name.split("-", 1)[1].partition("/")
+    return float(share), inner or "default"
+
+
 def _run(task):
     name, cell_index, index = task
     cell = CELLS[cell_index]
@@ -520,7 +538,9 @@ def _run(task):
         arena_table, seed = case(cell, "tuning", index)
     streams = case_streams(seed)
     arena = build_arena(arena_table, streams["arena"])
-    log = stripped_log(simulate(arena, cell.agents, cell.duration, rng=streams["simulation"]).log)
+    static, name = _static_share(name)
+    log = stripped_log(simulate(arena, cell.agents, cell.duration, static_fraction=static,
+                                rng=streams["simulation"]).log)
     family = arena_table["shapes"][0] if arena_table["holes"] else "no hole"
     start = time.perf_counter()
     try:
@@ -537,7 +557,7 @@ def main() -> None:
     parser.add_argument("--per-cell", type=int, default=12)
     parser.add_argument("--variants", nargs="+", default=["default", "20s", "whole", "quarter", "draws", "switch"],
                         help=f"{', '.join(sorted(VARIANTS))}, diffusive-C, switch-C, log-C, wall-C, wall-none, "
-                             "smooth-HOW-K, pad-F, paths-C, dtm-K, mds-D, mix-K1-K2[-whole], draws-K[/VARIANT], trace/VARIANT, seed+D, "
+                             "static-F[/VARIANT], smooth-HOW-K, pad-F, paths-C, dtm-K, mds-D, mix-K1-K2[-whole], draws-K[/VARIANT], trace/VARIANT, seed+D, "
                              "tcorr-S or "
                              "FIELD=VALUE; "
                              "VARIANT@D: with the landmark draw of seed + D")
@@ -568,6 +588,10 @@ def main() -> None:
             print(f"{name}, {pooling}: {int(right.sum())}/{len(tasks)} exact (q {th.q:g}, tau {th.tau:g}); "
                   f"4-fold CV {cv}/{len(tasks)}; per cell {per_cell}; per hole family {per_family}; "
                   f"{seconds:.2f} s per map", flush=True)
+        shipped = exact(maps, SHIPPED.thresholds_[1], SHIPPED.pooling)
+        per_cell = [int(sum(ok for m, ok in zip(maps, shipped) if m.cell == CELLS[c].name)) for c in cells]
+        print(f"{name}, read by the shipped default classifier: {int(shipped.sum())}/{len(tasks)} exact; "
+              f"per cell {per_cell}", flush=True)
 
 
 if __name__ == "__main__":

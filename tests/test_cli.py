@@ -206,6 +206,16 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     scaled = run("map", simulated[0], "--out", tmp_path / "s", "-q", "--window-scales", "0.5,1")
     assert scaled.returncode == 0, scaled.stderr
     assert json.loads((tmp_path / "s" / "map.json").read_text())["params"]["window_scales"] == [0.5, 1.0]
+    assert doc["params"]["max_windows"] == MapConfig.max_windows
+    capped = run("map", simulated[0], "--out", tmp_path / "c", "-q", "--window-length", "4", "--max-windows", "3")
+    assert capped.returncode == 0, capped.stderr
+    doc = json.loads((tmp_path / "c" / "map.json").read_text())
+    assert doc["params"]["max_windows"] == 3 and len(doc["regions"][0]["windows"]) == 3  # one per length
+    every = run("map", simulated[0], "--out", tmp_path / "e", "-q", "--window-length", "4", "--max-windows", "none")
+    assert every.returncode == 0, every.stderr
+    doc = json.loads((tmp_path / "e" / "map.json").read_text())
+    assert doc["params"]["max_windows"] is None and len(doc["regions"][0]["windows"]) > 3
+    assert_one_line_error(run("map", simulated[0], "--max-windows", "0"), "whole number >= 1", code=2)
     assert_one_line_error(run("map", simulated[0], "--window-scales", "1,0"), "distinct positive numbers", code=2)
     assert_one_line_error(run("map", simulated[0], "--window-scales", "1,x"), "comma-separated", code=2)
     assert_one_line_error(run("map", simulated[0], "--paper", "--window-scales", "1,2"),

@@ -66,3 +66,9 @@ def test_padding_by_nothing_is_the_default_and_restores_the_pipeline():
     assert [[d.lengths(1).tolist() for d in r] for r in padded] == [[d.lengths(1).tolist() for d in r] for r in default]
     wider, _ = levers._variant("pad-0.5")(log, 9)
     assert [len(r) for r in wider] == [len(r) for r in default]  # the same windows, mapped from wider graphs
+
+
+def test_static_variants_name_their_share_and_inner_variant():
+    assert levers._static_share("static-0.1") == (0.1, "default")
+    assert levers._static_share("static-0.2/pad-0.5") == (0.2, "pad-0.5")
+    assert levers._static_share("wall-3") == (0.0, "wall-3")

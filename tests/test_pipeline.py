@@ -126,6 +126,10 @@ def test_window_restricts_events():
     (dict(wall_follow_weight=float("inf")), "wall_follow_weight"),
     (dict(window_length=0.0), "window_length"),
     (dict(window_step=float("nan")), "window_step"),
+    (dict(max_windows=0), "max_windows"),
+    (dict(max_windows=2.5), "max_windows"),
+    (dict(max_windows=True), "max_windows"),
+    (dict(max_windows="48"), "max_windows"),
 ])
 def test_bad_config_is_refused(bad, match):
     with pytest.raises(SwarmtopoError, match=match):
@@ -195,6 +199,34 @@ def test_scaled_windows_are_the_distinct_windows_of_every_length():
                                                        (15.0, 30.0), None]
     assert _scaled_windows(t, [20.0, 20.0]) == _windows(t, 20.0)  # a window is pooled once
     assert _scaled_windows(t, [30.0, WHOLE_LOG]) == [None]
+
+
+def test_capped_windows_keep_an_even_share_of_every_length():
+    t = np.array([0.0, 100.0])
+    # 10 s: 19 windows every 5 s; 20 s: 9 every 10 s; 28 windows in all
+    every = _scaled_windows(t, [10.0, 20.0])
+    assert len(every) == 28 and _scaled_windows(t, [10.0, 20.0], cap=28) == every
+    capped = _scaled_windows(t, [10.0, 20.0], cap=7)
+    # floor(7 x 19 / 28) = 4 of the 10 s windows, floor(7 x 9 / 28) = 2 of the 20 s ones, first to last
+    assert capped == [(0.0, 10.0), (30.0, 40.0), (60.0, 70.0), (90.0, 100.0), (0.0, 20.0), (80.0, 100.0)]
+    assert _scaled_windows(t, [10.0, 20.0, 50.0], cap=1) == [(0.0, 10.0), (0.0, 20.0), (0.0, 50.0)]  # one per length
+
+
+def test_a_long_log_maps_at_most_max_windows():
+    import dataclasses
+
+    from swarmtopo.pipeline import ADVICE_BELOW
+
+    log = simulate(default_arena(), 150, 30.0, rng=2).log
+    base = dict(window_length=6.0, window_scales=(1.0, 1.5), **FAST)
+    every = map_encounters(log, MapConfig(max_windows=None, **base)).regions[0].windows
+    capped = map_encounters(log, MapConfig(max_windows=5, **base))
+    assert len(every) > 5 >= len(capped.regions[0].windows)
+    kept = [(w.t0, w.t1) for w in capped.regions[0].windows]
+    assert set(kept) <= {(w.t0, w.t1) for w in every} and len({round(b - a, 9) for a, b in kept}) == 2
+    assert capped.to_json()["params"]["max_windows"] == 5
+    unsure = dataclasses.replace(capped, confidence={0: 0.99, 1: ADVICE_BELOW - 0.2})
+    assert unsure.advice()[-1].startswith("to raise it: use more agents")  # a longer log adds no window
 
 
 def test_window_scales_pool_the_windows_of_every_scale():

@@ -208,6 +208,19 @@ def _parse_scales(text: Optional[str]):
     return scales
 
 
+def _parse_max_windows(text: Optional[str]):
+    """A --max-windows value: a whole number >= 1 or 'none' (every window)."""
+    if text is None or text.strip().lower() == "none":
+        return text and "none"
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise typer.BadParameter(f"{text!r} is not a whole number >= 1 or 'none'")
+    return str(value)
+
+
 @app.command("map", epilog="Example: swarmtopo map runs/two-holes --out runs/two-holes/map --metric hybrid --landmarks 300")
 def map_command(
     log_dir: Path = typer.Argument(..., help="Log folder: events.csv|parquet, optional status, meta.json."),
@@ -244,6 +257,11 @@ def map_command(
         None, "--window-scales", callback=_parse_scales,
         help="Comma-separated multipliers of the window length: the windows of every such length are pooled "
              "together (default: 0.75,1,1.25; 1 maps one length, about three times faster: docs/accuracy.md)."),
+    max_windows: Optional[str] = typer.Option(
+        None, "--max-windows", callback=_parse_max_windows,
+        help="Cap of the time windows mapped, all lengths together (default 48, more than any benchmark map "
+             "pools): a longer log maps an evenly spaced subset, so its time stops growing with its length; "
+             "'none' maps every window."),
     classifier: Optional[str] = typer.Option(
         None, "--classifier",
         help="Betti classifier: default (tuned on the accuracy benchmark), trace (the same tuned on its logs read "
@@ -279,7 +297,9 @@ def map_command(
                        seed=seed, hop_cost=hop_cost, diffusion_time=seconds_option(diffusion_time),
                        wall_follow_weight=wall_follow_option(wall_follow_weight),
                        window_length=seconds_option(window_length),
-                       window_scales=window_scales or MapConfig.window_scales)
+                       window_scales=window_scales or MapConfig.window_scales,
+                       max_windows=(MapConfig.max_windows if max_windows is None else
+                                    None if max_windows == "none" else int(max_windows)))
     if verbose:
         _detail(f"log {log_dir}: {log.n_events} encounters of {log.n_agents} agents over {log.duration:g} s")
     tmap, written = _run_map(log, config, log_dir, out_dir, quiet, verbose, classifier=model)

@@ -61,6 +61,9 @@ inside a chain gap, outside the diffusive compression (docs/tuning.md)."""
 WINDOW_SCALES = (0.75, 1.0, 1.25)
 """Default ``MapConfig.window_scales``: multipliers of the window length whose windows
 are all pooled (windows of 15, 20 and 25 encounters per agent; docs/tuning.md)."""
+MAX_WINDOWS = 48
+"""Default ``MapConfig.max_windows``: more than any map of the accuracy benchmark pools
+(at most 44), so its measured accuracy holds; a longer log maps an evenly spaced subset."""
 WHOLE_LOG = float("inf")
 """``MapConfig.window_length`` that maps the whole log at once (the paper)."""
 
@@ -137,6 +140,12 @@ class MapConfig:
         window length, so windows overlap by half and a log of T seconds gets
         ceil(2 T / window_length) - 1 of them, evenly spaced from the first event to
         the last.
+    max_windows
+        Cap of the windows mapped, all lengths together (default ``MAX_WINDOWS``): a log
+        with more keeps of each length's windows an evenly spaced share in proportion
+        to their number (at least one per length), so the map's time stops growing
+        with the log's length while the pooled windows still span it.  None maps
+        every window.
     subsample
         Landmark subsampler: ``maxmin``, ``knn`` (KNN-filtered maxmin) or
         ``probabilistic`` (probabilistic maxmin).
@@ -177,6 +186,7 @@ class MapConfig:
     window_encounters: float = 20.0
     window_scales: tuple[float, ...] = WINDOW_SCALES
     window_step: float | None = None
+    max_windows: int | None = MAX_WINDOWS
     subsample: str = "maxmin"
     landmarks: int | None = None
     max_landmarks: int = 400
@@ -225,6 +235,9 @@ class MapConfig:
             raise SwarmtopoError(f"window_scales must be distinct, got {list(scales)}")
         if self.window_step is not None and not (np.isfinite(self.window_step) and self.window_step > 0):
             raise SwarmtopoError(f"window_step must be a positive number of seconds, got {self.window_step}")
+        if self.max_windows is not None and (isinstance(self.max_windows, bool) or
+                                             not isinstance(self.max_windows, (int, np.integer)) or self.max_windows < 1):
+            raise SwarmtopoError(f"max_windows must be a whole number >= 1 or None, got {self.max_windows}")
         if self.maxdim not in (1, 2):
             raise SwarmtopoError(f"maxdim must be 1 or 2, got {self.maxdim}")
         if self.embed_dim not in (0, 2, 3):
@@ -331,11 +344,13 @@ class TopologicalMap:
             if len(set(counts)) > 1:
                 lines.append(f"region {r.component}: its {len(counts)} time windows counted {counts} holes each")
         length = self.window_length[0]
-        more_time = (f"record longer (each extra {self.config.window_step or length / 2:.3g} s adds a window to "
-                     "the pooling)" if np.isfinite(length) else "record longer")
-        lines.append(f"to raise it: {more_time}, use more agents than {self.n_agents} (denser windows), or leave "
-                     "some agents static (hybrid metric: free links across time); 'swarmtopo plan --area A --agents N "
-                     "--target 0.95' tells how much")
+        capped = self.config.max_windows is not None and max(len(r.windows) for r in self.regions) >= \
+            self.config.max_windows
+        more_time = ("" if capped else
+                     f"record longer (each extra {self.config.window_step or length / 2:.3g} s adds a window to "
+                     "the pooling), " if np.isfinite(length) else "record longer, ")
+        lines.append(f"to raise it: {more_time}use more agents than {self.n_agents} (denser windows); "
+                     "'swarmtopo plan --area A --agents N --target 0.95' tells how much")
         return lines
 
     def to_json(self) -> dict[str, Any]:
@@ -445,7 +460,7 @@ def map_encounters(
     spans = _scaled_windows(graph.event_t, [
         resolve_window(agent_gap, None if config.window_length is None else scale * config.window_length,
                        scale * config.window_encounters, log_span)[0] for scale in config.window_scales],
-        config.window_step)
+        config.window_step, config.max_windows)
     window_graphs = []  # (span, graph, component labels) of each window
     for span in spans:
         if span is None:  # the whole log: a scale whose windows would not be shorter than it
@@ -630,10 +645,18 @@ def _windows(event_t: np.ndarray, length: float, step: float | None = None) -> l
     return [(float(s), float(s) + length) for s in np.linspace(t_first, t_last - length, n)]
 
 
-def _scaled_windows(event_t: np.ndarray, lengths, step: float | None = None) -> list[tuple[float, float] | None]:
+def _scaled_windows(event_t: np.ndarray, lengths, step: float | None = None,
+                    cap: int | None = None) -> list[tuple[float, float] | None]:
     """The distinct windows of every length in ``lengths`` (:func:`_windows`), in order:
-    by length as given, then by start."""
-    return list(dict.fromkeys(span for length in lengths for span in _windows(event_t, length, step)))
+    by length as given, then by start.  With more than ``cap`` windows in all, each
+    length keeps floor(cap x its share) of its windows, at least one, evenly spaced
+    from its first to its last (``MapConfig.max_windows``)."""
+    per_length = [_windows(event_t, length, step) for length in lengths]
+    total = sum(len(spans) for spans in per_length)
+    if cap is not None and total > cap:
+        per_length = [[spans[i] for i in np.unique(np.linspace(0, len(spans) - 1, max(1, cap * len(spans) // total))
+                                                  .round().astype(int))] for spans in per_length]
+    return list(dict.fromkeys(span for spans in per_length for span in spans))
 
 
 def _events_within(log: EncounterLog, span: tuple[float, float]) -> int:
