@@ -9,7 +9,11 @@ shipped classifier, and the lower median of the windows' counts, as before): fit
 exact (beta_0, beta_1), the 4-fold cross-validated count (thresholds fitted without
 each quarter), per-cell counts, counts per hole family (the family of a case's holes;
 "no hole" for none) and seconds per map; then the exact count and per-cell counts when
-the maps are read by the shipped ``default`` classifier, as ``swarmtopo map`` reads them.
+the maps are read by the shipped ``default`` classifier (as ``swarmtopo map`` reads a
+log with status changes; ``trace/`` variants' maps too, which ``map`` would read with
+the ``trace`` classifier).  Windows are never capped (``MapConfig.max_windows`` None)
+unless a variant sets the cap: the suite's maps have at most 44 windows, but variants
+that add windows would otherwise be cut back to 48.
 
 Variants (all: hybrid metric, maxmin, automatic landmarks, h = r_d / v_c, automatic
 diffusion time, wall following x 2):
@@ -48,7 +52,8 @@ diffusion time, wall following x 2):
   diffusive weights (``MapConfig.wall_follow_weight``; the default is C = 2);
   ``wall-none`` charges it like any other time.
 * ``pad-F`` -- each window's graph built on the window widened by F x its length on
-  both sides, landmarks drawn (maxmin) only among the nodes inside the window: paths may
+  both sides, landmarks drawn (maxmin, whatever ``subsample`` says) only among the nodes
+  inside the window: paths may
   leave the window in time, so the events at its edges are no longer the ends of cut
   chains, which maxmin otherwise favours as outliers.
 * ``smooth-HOW-K`` -- Vietoris-Rips on neighbourhood-averaged landmark distances:
@@ -125,7 +130,9 @@ from swarmtopo.sim import simulate
 
 
 def _windows_of(log, seed, **options):
-    tmap = map_encounters(log, MapConfig(seed=seed, embed_dim=0, cycles=False, **options))
+    """Each region's windows' diagrams and beta_0, every window mapped (no ``max_windows``
+    cap, so window variants map the windows they describe) unless ``options`` set one."""
+    tmap = map_encounters(log, MapConfig(seed=seed, embed_dim=0, cycles=False, **{"max_windows": None, **options}))
     return [[w.diagram for w in r.windows] for r in tmap.regions], tmap.betti[0]
 
 
@@ -524,11 +531,12 @@ VARIANTS = {
 
 
 def _static_share(name):
-    """(static fraction, variant) of ``static-F[/VARIANT]`` (the default without ``/``), else (0, name)."""
+    """(static fraction, variant) of ``static-F[/VARIANT][@D]`` (the default without ``/``), else (0, name)."""
     if not name.startswith("static-"):
         return 0.0, name
     share, _, inner = name.split("-", 1)[1].partition("/")
-    return float(share), inner or "default"
+    share, at, draw = share.partition("@")
+    return float(share), (inner or "default") + at + draw
 
 
 def _run(task):

@@ -215,7 +215,11 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     assert every.returncode == 0, every.stderr
     doc = json.loads((tmp_path / "e" / "map.json").read_text())
     assert doc["params"]["max_windows"] is None and len(doc["regions"][0]["windows"]) > 3
-    assert_one_line_error(run("map", simulated[0], "--max-windows", "0"), "whole number >= 1", code=2)
+    for bad in ("0", "-1", "2.5", "abc"):
+        assert_one_line_error(run("map", simulated[0], "--max-windows", bad), "whole number >= 1", code=2)
+    assert_one_line_error(run("map", simulated[0], "--max-windows", "2"), "at least the number of window scales")
+    assert_one_line_error(run("map", simulated[0], "--paper", "--max-windows", "5"), "--paper fixes --max-windows",
+                          code=2)
     assert_one_line_error(run("map", simulated[0], "--window-scales", "1,0"), "distinct positive numbers", code=2)
     assert_one_line_error(run("map", simulated[0], "--window-scales", "1,x"), "comma-separated", code=2)
     assert_one_line_error(run("map", simulated[0], "--paper", "--window-scales", "1,2"),

@@ -57,7 +57,7 @@ def test_draws_of_a_variant_pool_that_variants_windows_at_consecutive_seeds():
 
 def test_padding_by_nothing_is_the_default_and_restores_the_pipeline():
     """``pad-0``: the window's own graph, every node a candidate, the same first pick: the default's diagrams."""
-    log = simulate(random_arena(2, rng=4), 80, 12.0, rng=4).log
+    log = simulate(random_arena(2, rng=4), 200, 30.0, rng=4).log
     originals = (levers.P.build_graph, levers.P._map_window, levers.P._subsample)
     padded, beta0 = levers._variant("pad-0")(log, 9)
     default, default_beta0 = levers._windows_of(log, 9)
@@ -65,10 +65,12 @@ def test_padding_by_nothing_is_the_default_and_restores_the_pipeline():
     assert beta0 == default_beta0
     assert [[d.lengths(1).tolist() for d in r] for r in padded] == [[d.lengths(1).tolist() for d in r] for r in default]
     wider, _ = levers._variant("pad-0.5")(log, 9)
-    assert [len(r) for r in wider] == [len(r) for r in default]  # the same windows, mapped from wider graphs
+    assert [len(r) for r in wider] == [len(r) for r in default] and len(default[0]) > 1  # the same windows
+    assert [[d.lengths(1).tolist() for d in r] for r in wider] != [[d.lengths(1).tolist() for d in r] for r in default]
 
 
 def test_static_variants_name_their_share_and_inner_variant():
     assert levers._static_share("static-0.1") == (0.1, "default")
     assert levers._static_share("static-0.2/pad-0.5") == (0.2, "pad-0.5")
+    assert levers._static_share("static-0.1@2") == (0.1, "default@2")
     assert levers._static_share("wall-3") == (0.0, "wall-3")

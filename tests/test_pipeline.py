@@ -127,6 +127,7 @@ def test_window_restricts_events():
     (dict(window_length=0.0), "window_length"),
     (dict(window_step=float("nan")), "window_step"),
     (dict(max_windows=0), "max_windows"),
+    (dict(max_windows=2), "at least the number of window scales"),
     (dict(max_windows=2.5), "max_windows"),
     (dict(max_windows=True), "max_windows"),
     (dict(max_windows="48"), "max_windows"),
@@ -195,21 +196,42 @@ def test_windows_hand_computed():
 def test_scaled_windows_are_the_distinct_windows_of_every_length():
     t = np.array([0.0, 7.0, 30.0])
     # 20 s: [0, 20], [10, 30]; 15 s (step 7.5): [0, 15], [7.5, 22.5], [15, 30]; 30 s: the whole log
-    assert _scaled_windows(t, [20.0, 15.0, 30.0]) == [(0.0, 20.0), (10.0, 30.0), (0.0, 15.0), (7.5, 22.5),
-                                                       (15.0, 30.0), None]
-    assert _scaled_windows(t, [20.0, 20.0]) == _windows(t, 20.0)  # a window is pooled once
-    assert _scaled_windows(t, [30.0, WHOLE_LOG]) == [None]
+    assert _scaled_windows(t, [20.0, 15.0, 30.0]) == ([(0.0, 20.0), (10.0, 30.0), (0.0, 15.0), (7.5, 22.5),
+                                                        (15.0, 30.0), None], 0)
+    assert _scaled_windows(t, [20.0, 20.0]) == (_windows(t, 20.0), 0)  # a window is pooled once
+    assert _scaled_windows(t, [30.0, WHOLE_LOG]) == ([None], 0)
+    assert _scaled_windows(t, [30.0, WHOLE_LOG], cap=1) == ([None], 0)  # counted once, so not over the cap
 
 
 def test_capped_windows_keep_an_even_share_of_every_length():
     t = np.array([0.0, 100.0])
     # 10 s: 19 windows every 5 s; 20 s: 9 every 10 s; 28 windows in all
-    every = _scaled_windows(t, [10.0, 20.0])
-    assert len(every) == 28 and _scaled_windows(t, [10.0, 20.0], cap=28) == every
-    capped = _scaled_windows(t, [10.0, 20.0], cap=7)
-    # floor(7 x 19 / 28) = 4 of the 10 s windows, floor(7 x 9 / 28) = 2 of the 20 s ones, first to last
-    assert capped == [(0.0, 10.0), (30.0, 40.0), (60.0, 70.0), (90.0, 100.0), (0.0, 20.0), (80.0, 100.0)]
-    assert _scaled_windows(t, [10.0, 20.0, 50.0], cap=1) == [(0.0, 10.0), (0.0, 20.0), (0.0, 50.0)]  # one per length
+    every, left_out = _scaled_windows(t, [10.0, 20.0])
+    assert len(every) == 28 and left_out == 0 and _scaled_windows(t, [10.0, 20.0], cap=28) == (every, 0)
+    # quotas 7 x 19 / 28 = 4.75 and 7 x 9 / 28 = 2.25: floors 4 and 2, the seat left to the larger remainder
+    capped, left_out = _scaled_windows(t, [10.0, 20.0], cap=7)
+    assert left_out == 21
+    # 5 of the 19 10 s windows, indices 0, 4.5, 9, 13.5, 18 rounded half to even; 2 of the 9 20 s ones
+    assert capped == [(0.0, 10.0), (20.0, 30.0), (45.0, 55.0), (70.0, 80.0), (90.0, 100.0),
+                      (0.0, 20.0), (80.0, 100.0)]
+    # one per length at the least, the middle window when only one is kept
+    assert _scaled_windows(t, [10.0, 20.0], cap=2) == ([(45.0, 55.0), (40.0, 60.0)], 26)
+    with pytest.raises(SwarmtopoError, match="one of each"):
+        _scaled_windows(t, [10.0, 20.0, 50.0], cap=2)
+
+
+def test_window_shares_sum_to_the_cap_and_keep_one_per_length():
+    from swarmtopo.pipeline import _shares
+
+    # 48 x (399, 3, 2) / 404 = (47.41, 0.36, 0.24): the floors (47, 0, 0) raised to one each exceed
+    # the cap, so the largest share gives one back
+    assert _shares(np.array([399, 3, 2]), 48).tolist() == [46, 1, 1]
+    # the 10^6-event log: 48 x (126, 95, 76) / 297 = (20.36, 15.35, 12.28), the seat left to the first
+    assert _shares(np.array([126, 95, 76]), 48).tolist() == [21, 15, 12]
+    for sizes in ([5, 5, 5], [100, 1, 1], [60, 0, 3], [7, 9, 11, 13]):
+        for cap in range(4, sum(sizes)):
+            keep = _shares(np.array(sizes), cap)
+            assert keep.sum() == cap and (keep <= sizes).all() and (keep >= np.minimum(sizes, 1)).all()
 
 
 def test_a_long_log_maps_at_most_max_windows():
@@ -220,11 +242,13 @@ def test_a_long_log_maps_at_most_max_windows():
     log = simulate(default_arena(), 150, 30.0, rng=2).log
     base = dict(window_length=6.0, window_scales=(1.0, 1.5), **FAST)
     every = map_encounters(log, MapConfig(max_windows=None, **base)).regions[0].windows
-    capped = map_encounters(log, MapConfig(max_windows=5, **base))
-    assert len(every) > 5 >= len(capped.regions[0].windows)
+    capped = map_encounters(log, MapConfig(max_windows=6, **base))
+    assert len(every) > 6 == len(capped.regions[0].windows)
     kept = [(w.t0, w.t1) for w in capped.regions[0].windows]
     assert set(kept) <= {(w.t0, w.t1) for w in every} and len({round(b - a, 9) for a, b in kept}) == 2
-    assert capped.to_json()["params"]["max_windows"] == 5
+    params = capped.to_json()["params"]
+    assert params["max_windows"] == 6 and params["windows_left_out"] == len(every) - 6
+    assert map_encounters(log, MapConfig(max_windows=None, **base)).windows_left_out == 0
     unsure = dataclasses.replace(capped, confidence={0: 0.99, 1: ADVICE_BELOW - 0.2})
     assert unsure.advice()[-1].startswith("to raise it: use more agents")  # a longer log adds no window
 

@@ -259,9 +259,9 @@ def map_command(
              "together (default: 0.75,1,1.25; 1 maps one length, about three times faster: docs/accuracy.md)."),
     max_windows: Optional[str] = typer.Option(
         None, "--max-windows", callback=_parse_max_windows,
-        help="Cap of the time windows mapped, all lengths together (default 48, more than any benchmark map "
-             "pools): a longer log maps an evenly spaced subset, so its time stops growing with its length; "
-             "'none' maps every window."),
+        help="Cap of the time windows mapped, all lengths together, at least one per length (default 48, more "
+             "than any benchmark map pools): a longer log maps an evenly spaced share of each length's windows, so "
+             "its time stops growing with its length; 'none' maps every window."),
     classifier: Optional[str] = typer.Option(
         None, "--classifier",
         help="Betti classifier: default (tuned on the accuracy benchmark), trace (the same tuned on its logs read "
@@ -284,7 +284,7 @@ def map_command(
         given = [name for name, value in (("--hop-cost", hop_cost), ("--diffusion-time", diffusion_time),
                                           ("--wall-follow-weight", wall_follow_weight),
                                           ("--window-length", window_length), ("--window-scales", window_scales),
-                                          ("--classifier", classifier))
+                                          ("--max-windows", max_windows), ("--classifier", classifier))
                  if value is not None]
         if given:
             raise typer.BadParameter(f"--paper fixes {', '.join(given)}; drop one or the other")

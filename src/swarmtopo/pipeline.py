@@ -141,11 +141,11 @@ class MapConfig:
         ceil(2 T / window_length) - 1 of them, evenly spaced from the first event to
         the last.
     max_windows
-        Cap of the windows mapped, all lengths together (default ``MAX_WINDOWS``): a log
-        with more keeps of each length's windows an evenly spaced share in proportion
-        to their number (at least one per length), so the map's time stops growing
-        with the log's length while the pooled windows still span it.  None maps
-        every window.
+        Cap of the windows mapped, all lengths together (default ``MAX_WINDOWS``; at
+        least the number of ``window_scales``): a log with more keeps of each length's
+        windows an evenly spaced share in proportion to their number, at least one
+        each, ``max_windows`` in all, so the map's time stops growing with the log's
+        length while the pooled windows still span it.  None maps every window.
     subsample
         Landmark subsampler: ``maxmin``, ``knn`` (KNN-filtered maxmin) or
         ``probabilistic`` (probabilistic maxmin).
@@ -236,8 +236,10 @@ class MapConfig:
         if self.window_step is not None and not (np.isfinite(self.window_step) and self.window_step > 0):
             raise SwarmtopoError(f"window_step must be a positive number of seconds, got {self.window_step}")
         if self.max_windows is not None and (isinstance(self.max_windows, bool) or
-                                             not isinstance(self.max_windows, (int, np.integer)) or self.max_windows < 1):
-            raise SwarmtopoError(f"max_windows must be a whole number >= 1 or None, got {self.max_windows}")
+                                             not isinstance(self.max_windows, (int, np.integer)) or
+                                             self.max_windows < len(scales)):
+            raise SwarmtopoError(f"max_windows must be a whole number, at least the number of window scales "
+                                 f"({len(scales)}: one window per length), or None; got {self.max_windows}")
         if self.maxdim not in (1, 2):
             raise SwarmtopoError(f"maxdim must be 1 or 2, got {self.maxdim}")
         if self.embed_dim not in (0, 2, 3):
@@ -326,6 +328,7 @@ class TopologicalMap:
     hop_cost: tuple[float, str] = (0.0, "given")  # (h used, where it came from)
     diffusion_time: tuple[float, str] = (WHOLE_LOG, "given")  # (tau used, where it came from)
     window_length: tuple[float, str] = (WHOLE_LOG, "given")  # (window length used, where it came from)
+    windows_left_out: int = 0  # windows the cap (MapConfig.max_windows) left unmapped
     software: dict[str, str] = field(default_factory=dict)
 
     @property
@@ -344,9 +347,7 @@ class TopologicalMap:
             if len(set(counts)) > 1:
                 lines.append(f"region {r.component}: its {len(counts)} time windows counted {counts} holes each")
         length = self.window_length[0]
-        capped = self.config.max_windows is not None and max(len(r.windows) for r in self.regions) >= \
-            self.config.max_windows
-        more_time = ("" if capped else
+        more_time = ("" if self.windows_left_out else
                      f"record longer (each extra {self.config.window_step or length / 2:.3g} s adds a window to "
                      "the pooling), " if np.isfinite(length) else "record longer, ")
         lines.append(f"to raise it: {more_time}use more agents than {self.n_agents} (denser windows); "
@@ -388,7 +389,7 @@ class TopologicalMap:
                        "diffusion_time_used": self.diffusion_time[0] if np.isfinite(self.diffusion_time[0]) else None,
                        "diffusion_time_source": self.diffusion_time[1],
                        "window_length_used": self.window_length[0] if np.isfinite(self.window_length[0]) else None,
-                       "window_source": self.window_length[1]},
+                       "window_source": self.window_length[1], "windows_left_out": self.windows_left_out},
             "log": {"events": self.n_events, "agents": self.n_agents},
             "timings": {k: round(v, 6) for k, v in self.timings.items()},
             "software": {**self.software, "persistence_backend": self.diagram.backend},
@@ -457,7 +458,7 @@ def map_encounters(
               else [None] * len(regions_idx))
     log_span = float(graph.event_t.max() - graph.event_t.min())
     window_length, window_source = resolve_window(agent_gap, config.window_length, config.window_encounters, log_span)
-    spans = _scaled_windows(graph.event_t, [
+    spans, left_out = _scaled_windows(graph.event_t, [
         resolve_window(agent_gap, None if config.window_length is None else scale * config.window_length,
                        scale * config.window_encounters, log_span)[0] for scale in config.window_scales],
         config.window_step, config.max_windows)
@@ -548,6 +549,7 @@ def map_encounters(
         hop_cost=(hop_cost, hop_source),
         diffusion_time=(diffusion_time, diffusion_source),
         window_length=(window_length, window_source),
+        windows_left_out=left_out,
         software=software_versions(),
     )
 
@@ -646,17 +648,52 @@ def _windows(event_t: np.ndarray, length: float, step: float | None = None) -> l
 
 
 def _scaled_windows(event_t: np.ndarray, lengths, step: float | None = None,
-                    cap: int | None = None) -> list[tuple[float, float] | None]:
+                    cap: int | None = None) -> tuple[list[tuple[float, float] | None], int]:
     """The distinct windows of every length in ``lengths`` (:func:`_windows`), in order:
-    by length as given, then by start.  With more than ``cap`` windows in all, each
-    length keeps floor(cap x its share) of its windows, at least one, evenly spaced
-    from its first to its last (``MapConfig.max_windows``)."""
-    per_length = [_windows(event_t, length, step) for length in lengths]
-    total = sum(len(spans) for spans in per_length)
-    if cap is not None and total > cap:
-        per_length = [[spans[i] for i in np.unique(np.linspace(0, len(spans) - 1, max(1, cap * len(spans) // total))
-                                                  .round().astype(int))] for spans in per_length]
-    return list(dict.fromkeys(span for spans in per_length for span in spans))
+    by length as given, then by start; and how many the cap left out.
+
+    With more than ``cap`` distinct windows, each length keeps a share of its windows
+    in proportion to their number, at least one (largest remainders, so the shares sum
+    to ``cap``; ``MapConfig.validate`` asks for at least one per length), evenly spaced
+    from its first window to its last (one window: the middle one)."""
+    seen: set = set()
+    per_length = []
+    for length in lengths:
+        spans = [span for span in _windows(event_t, length, step) if span not in seen]
+        seen.update(spans)
+        per_length.append(spans)
+    sizes = np.array([len(spans) for spans in per_length])
+    total = int(sizes.sum())
+    if cap is None or total <= cap:
+        return [span for spans in per_length for span in spans], 0
+    keep = _shares(sizes, cap)
+    kept = [[spans[i] for i in _evenly(len(spans), k)] for spans, k in zip(per_length, keep)]
+    return [span for spans in kept for span in spans], total - int(keep.sum())
+
+
+def _shares(sizes: np.ndarray, cap: int) -> np.ndarray:
+    """How many of ``sizes[i]`` items each group keeps, ``cap`` in all (``cap`` <
+    sizes.sum()): proportional shares, at least one per non-empty group, the seats left
+    after the floors going to the largest remainders."""
+    if cap < np.count_nonzero(sizes):
+        raise SwarmtopoError(f"a cap of {cap} windows cannot keep one of each of {np.count_nonzero(sizes)} lengths")
+    quota = cap * sizes / sizes.sum()
+    keep = np.minimum(np.maximum(np.floor(quota).astype(int), (sizes > 0).astype(int)), sizes)
+    while keep.sum() > cap:  # the minimum of one pushed the floors over the cap
+        keep[np.argmax(np.where(keep > 1, keep - quota, -np.inf))] -= 1
+    for i in np.argsort(-(quota - keep), kind="stable"):
+        if keep.sum() == cap:
+            break
+        if keep[i] < sizes[i]:
+            keep[i] += 1
+    return keep
+
+
+def _evenly(n: int, k: int) -> np.ndarray:
+    """k of the indices 0 .. n-1, evenly spaced from the first to the last (k = 1: the middle one)."""
+    if k == 1:
+        return np.array([(n - 1) // 2])
+    return np.unique(np.linspace(0, n - 1, k).round().astype(int))
 
 
 def _events_within(log: EncounterLog, span: tuple[float, float]) -> int:

@@ -126,7 +126,8 @@ def map_input(mapping: dict[str, Any]) -> str:
 def job_map_config(mapping: dict[str, Any], seed: int | None = None) -> MapConfig:
     """The ``MapConfig`` of a job's canonical ``[map]`` table ("auto" -> None, from the
     data; "none" -> inf, except a "none" wall-following weight -> None), as sweeps map:
-    no picture, no loops."""
+    no picture, no loops; every other option is ``swarmtopo map``'s default, the window
+    cap ``max_windows`` included (not a grid key: no map of the accuracy suite reaches it)."""
     return MapConfig(
         metric=mapping["metric"], subsample=mapping["subsample"],
         hop_cost=seconds_option(mapping["hop_cost"]),
