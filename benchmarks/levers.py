@@ -74,7 +74,8 @@ diffusion time, wall following x 2):
   start (placed at random like the rest, then never moving; the log's ``meta.json``
   lists them, so the hybrid metric links all of a static agent's encounters),
   ``static-F/VARIANT`` any variant so: what a deployment gains by parking some of its
-  agents, at the same swarm size.
+  agents, at the same swarm size.  ``extra-F`` adds F x the cell's agents, walking;
+  ``extra-static-F`` adds them static: given spare agents, park them or let them walk.
 * ``FIELD=VALUE`` -- ``MapConfig(FIELD=VALUE)`` (e.g. ``subsample=knn``, ``metric=plain``).
 * ``log-C`` -- chain gaps compressed logarithmically instead, tau ln(1 + w / tau), with
   tau = C x the mean time between an agent's encounters.
@@ -530,13 +531,25 @@ VARIANTS = {
 }
 
 
-def _static_share(name):
-    """(static fraction, variant) of ``static-F[/VARIANT][@D]`` (the default without ``/``), else (0, name)."""
-    if not name.startswith("static-"):
-        return 0.0, name
-    share, _, inner = name.split("-", 1)[1].partition("/")
+SWARM_PREFIXES = ("static-", "extra-static-", "extra-")
+"""Variant prefixes that change the simulated swarm (``_swarm``), longest match first."""
+
+
+def _swarm(name, agents):
+    """(agents, static fraction, variant) of a swarm variant (module docstring): ``static-F``
+    parks F of the ``agents``, ``extra-F`` adds F x ``agents`` walkers, ``extra-static-F``
+    adds them parked; ``/VARIANT`` maps with VARIANT (default without), ``@D`` keeps its
+    landmark draw.  Any other name: (agents, 0, name)."""
+    prefix = next((p for p in sorted(SWARM_PREFIXES, key=len, reverse=True) if name.startswith(p)), None)
+    if prefix is None:
+        return agents, 0.0, name
+    share, _, inner = name[len(prefix):].partition("/")
     share, at, draw = share.partition("@")
-    return float(share), (inner or "default") + at + draw
+    share, inner = float(share), (inner or "default") + at + draw
+    if prefix == "static-":
+        return agents, share, inner
+    total = int(round(agents * (1 + share)))
+    return total, ((total - agents) / total if prefix == "extra-static-" else 0.0), inner
 
 
 def _run(task):
@@ -546,9 +559,8 @@ def _run(task):
         arena_table, seed = case(cell, "tuning", index)
     streams = case_streams(seed)
     arena = build_arena(arena_table, streams["arena"])
-    static, name = _static_share(name)
-    log = stripped_log(simulate(arena, cell.agents, cell.duration, static_fraction=static,
-                                rng=streams["simulation"]).log)
+    agents, static, name = _swarm(name, cell.agents)
+    log = stripped_log(simulate(arena, agents, cell.duration, static_fraction=static, rng=streams["simulation"]).log)
     family = arena_table["shapes"][0] if arena_table["holes"] else "no hole"
     start = time.perf_counter()
     try:
@@ -565,7 +577,7 @@ def main() -> None:
     parser.add_argument("--per-cell", type=int, default=12)
     parser.add_argument("--variants", nargs="+", default=["default", "20s", "whole", "quarter", "draws", "switch"],
                         help=f"{', '.join(sorted(VARIANTS))}, diffusive-C, switch-C, log-C, wall-C, wall-none, "
-                             "static-F[/VARIANT], smooth-HOW-K, pad-F, paths-C, dtm-K, mds-D, mix-K1-K2[-whole], draws-K[/VARIANT], trace/VARIANT, seed+D, "
+                             "static-F, extra-F, extra-static-F (each [/VARIANT]), smooth-HOW-K, pad-F, paths-C, dtm-K, mds-D, mix-K1-K2[-whole], draws-K[/VARIANT], trace/VARIANT, seed+D, "
                              "tcorr-S or "
                              "FIELD=VALUE; "
                              "VARIANT@D: with the landmark draw of seed + D")

@@ -69,8 +69,11 @@ def test_padding_by_nothing_is_the_default_and_restores_the_pipeline():
     assert [[d.lengths(1).tolist() for d in r] for r in wider] != [[d.lengths(1).tolist() for d in r] for r in default]
 
 
-def test_static_variants_name_their_share_and_inner_variant():
-    assert levers._static_share("static-0.1") == (0.1, "default")
-    assert levers._static_share("static-0.2/pad-0.5") == (0.2, "pad-0.5")
-    assert levers._static_share("static-0.1@2") == (0.1, "default@2")
-    assert levers._static_share("wall-3") == (0.0, "wall-3")
+def test_swarm_variants_name_their_swarm_and_inner_variant():
+    assert levers._swarm("static-0.1", 200) == (200, 0.1, "default")
+    assert levers._swarm("static-0.2/pad-0.5", 200) == (200, 0.2, "pad-0.5")
+    assert levers._swarm("static-0.1@2", 200) == (200, 0.1, "default@2")
+    assert levers._swarm("extra-0.1", 200) == (220, 0.0, "default")
+    agents, static, inner = levers._swarm("extra-static-0.1/wall-3", 200)
+    assert (agents, inner) == (220, "wall-3") and round(static * agents) == 20  # the 20 added agents parked
+    assert levers._swarm("wall-3", 300) == (300, 0.0, "wall-3")
