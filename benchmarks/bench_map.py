@@ -40,7 +40,7 @@ from _measure import machine, revision, run_measured
 from bench_landmarks import compare_with_dense
 from swarmtopo.graph import build_graph
 from swarmtopo.landmarks import SUBSAMPLERS
-from swarmtopo.pipeline import MapConfig, map_encounters
+from swarmtopo.pipeline import MapConfig, map_encounters, max_windows_option
 
 N_LANDMARKS = 500
 METRICS = ("plain", "hybrid")
@@ -76,7 +76,7 @@ def whole_map(n_events, subsamplers=SUBSAMPLERS, max_windows=MapConfig.max_windo
             limit = TIME_LIMIT[subsample]
             met = wall < limit and peak < MEMORY_LIMIT
             windows = sum(len(r.windows) for r in result.regions)
-            print(f"| {metric} | {subsample} | {windows} | {stage['graph']:.2f} | {stage['landmarks']:.2f} | "
+            print(f"| {metric} | {subsample} | {windows} of {windows + result.windows_left_out} | {stage['graph']:.2f} | {stage['landmarks']:.2f} | "
                   f"{stage['persistence']:.2f} | {other:.2f} | {wall:.1f} | {cpu:.1f} | {peak / 2**20:.0f} | "
                   f"{result.betti[0]}, {result.betti[1]} | < {limit:.0f} s, < 4 GB | {'yes' if met else 'NO'} |",
                   flush=True)
@@ -105,7 +105,7 @@ def main():
                         help=f"cap of the windows mapped in part 1 (default {MapConfig.max_windows}, the pipeline's; "
                              "'none': every window)")
     args = parser.parse_args()
-    max_windows = None if args.max_windows == "none" else int(args.max_windows)
+    max_windows = max_windows_option(args.max_windows)
     print(f"machine: {machine()}; {numba.get_num_threads()} numba threads; swarmtopo {revision()}")
     warm_up()
     whole_map(10**5 if args.quick else 10**6, args.subsample, max_windows)

@@ -56,6 +56,7 @@ def main() -> None:
     parser.add_argument("--store", default="tuning.duckdb", help="a store written by scripts/tune_accuracy.py")
     args = parser.parse_args()
     maps = default_maps(args.store)
+    print(f"at most {max(len(region) for m in maps for region in m.regions)} windows per region")
     features, correct = cross_fitted_features(maps, "mean")
     y = np.array(correct)
     print(f"{args.store}: {len(maps)} default-pipeline tuning maps, {len(y)} with one region; "

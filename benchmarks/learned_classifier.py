@@ -38,8 +38,8 @@ from sklearn.preprocessing import StandardScaler
 
 from calibration import default_maps
 from swarmtopo.experiments.accuracy import CELLS
-from swarmtopo.experiments.tuning import exact, fit_thresholds
-from swarmtopo.ratio import LOG_RATIO_CAP, longest_bars, noise_length, pooled_scores, score_matrix
+from swarmtopo.experiments.tuning import cross_validated_exact
+from swarmtopo.ratio import LOG_RATIO_CAP, longest_bars, noise_length, score_matrix
 
 RANKS = 6
 """Ranks per region a learned model reads (the suite's arenas have at most 3 holes per region)."""
@@ -53,9 +53,10 @@ MODELS = {
 
 def rank_features(windows) -> np.ndarray:
     """(RANKS, features) of one region's windows (module docstring)."""
-    pooled = {q: np.r_[pooled_scores(windows, 1, q), np.zeros(RANKS + 1)][:RANKS + 1] for q in (0.5, 0.7, 0.9)}
-    scores = score_matrix(windows, 1, 0.5)
-    scores = np.pad(scores, ((0, 0), (0, max(0, RANKS - scores.shape[1]))))[:, :RANKS]
+    # each window's scores, RANKS + 1 ranks (a missing rank scores 0), at each q
+    scores = {q: np.pad(m, ((0, 0), (0, max(0, RANKS + 1 - m.shape[1]))))[:, :RANKS + 1]
+              for q, m in ((q, score_matrix(windows, 1, q)) for q in (0.5, 0.7, 0.9))}
+    pooled = {q: m.mean(axis=0) for q, m in scores.items()}  # ratio.pooled_scores
     ends = np.zeros((len(windows), RANKS, 2))  # ln(birth / l_q), ln(death / l_q); no bar: 0
     for w, diagram in enumerate(windows):
         lq = noise_length(diagram, 1, 0.5)
@@ -66,7 +67,8 @@ def rank_features(windows) -> np.ndarray:
     s = pooled[0.5]
     previous = np.r_[LOG_RATIO_CAP, s[:RANKS - 1]]
     n_bars = np.log(np.mean([max(len(d[1]), 1) for d in windows]))
-    return np.column_stack([pooled[0.5][:RANKS], pooled[0.7][:RANKS], pooled[0.9][:RANKS], scores.std(axis=0),
+    return np.column_stack([pooled[0.5][:RANKS], pooled[0.7][:RANKS], pooled[0.9][:RANKS],
+                            scores[0.5][:, :RANKS].std(axis=0),
                             previous - s[:RANKS], s[:RANKS] - s[1:RANKS + 1], ends.mean(axis=0),
                             np.full(RANKS, n_bars), np.full(RANKS, np.log(len(windows)))])
 
@@ -94,17 +96,6 @@ def learned_right(maps, features, make_model) -> np.ndarray:
     return right
 
 
-def ratio_right(maps) -> np.ndarray:
-    """The shipped rule with (q_1, tau_1) fitted on the other folds (``tuning.cross_validated``, per map)."""
-    fold = np.arange(len(maps)) % FOLDS
-    right = np.zeros(len(maps), bool)
-    for k in range(FOLDS):
-        held = np.flatnonzero(fold == k)
-        th = fit_thresholds([m for m, f in zip(maps, fold) if f != k]).thresholds
-        right[held] = exact([maps[i] for i in held], th)
-    return right
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--store", default="tuning.duckdb", help="a store written by scripts/tune_accuracy.py")
@@ -120,7 +111,7 @@ def main() -> None:
         order = np.arange(len(maps)) if shuffle == 0 else np.random.default_rng(shuffle).permutation(len(maps))
         ordered, ordered_features = [maps[i] for i in order], [features[i] for i in order]
         print("job order:" if shuffle == 0 else f"random order {shuffle}:")
-        for name, right in [("ratio", ratio_right(ordered))] + [
+        for name, right in [("ratio", cross_validated_exact(ordered, folds=FOLDS))] + [
                 (n, learned_right(ordered, ordered_features, make)) for n, make in MODELS.items()]:
             per_cell = [int(sum(ok for m, ok in zip(ordered, right) if m.cell == c.name)) for c in CELLS]
             print(f"  {name}: {int(right.sum())}/{len(maps)}; per cell {per_cell}", flush=True)

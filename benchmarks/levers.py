@@ -120,9 +120,8 @@ from swarmtopo import pipeline as P
 from swarmtopo.embed import mds
 from swarmtopo.classify import load_classifier
 from swarmtopo.errors import SwarmtopoError
-from swarmtopo.experiments.accuracy import CELLS, case, tuning_session
-from swarmtopo.experiments.grid import case_streams
-from swarmtopo.experiments.sweep import build_arena, contact_trace, stripped_log
+from swarmtopo.experiments.accuracy import CELLS, tuning_arena
+from swarmtopo.experiments.sweep import contact_trace, stripped_log
 from swarmtopo.experiments.tuning import TuningMap, cross_validated, exact, fit_thresholds
 from swarmtopo.persistence import Diagram, rips_persistence
 from swarmtopo.pipeline import WHOLE_LOG, MapConfig, map_encounters, mean_agent_gap, resolve_window
@@ -555,12 +554,9 @@ def _swarm(name, agents):
 def _run(task):
     name, cell_index, index = task
     cell = CELLS[cell_index]
-    with tuning_session():
-        arena_table, seed = case(cell, "tuning", index)
-    streams = case_streams(seed)
-    arena = build_arena(arena_table, streams["arena"])
+    arena_table, seed, arena, stream = tuning_arena(cell, index)
     agents, static, name = _swarm(name, cell.agents)
-    log = stripped_log(simulate(arena, agents, cell.duration, static_fraction=static, rng=streams["simulation"]).log)
+    log = stripped_log(simulate(arena, agents, cell.duration, static_fraction=static, rng=stream).log)
     family = arena_table["shapes"][0] if arena_table["holes"] else "no hole"
     start = time.perf_counter()
     try:

@@ -20,9 +20,8 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from swarmtopo.experiments.accuracy import CELLS, case, tuning_session
-from swarmtopo.experiments.grid import case_streams
-from swarmtopo.experiments.sweep import build_arena, stripped_log
+from swarmtopo.experiments.accuracy import CELLS, tuning_arena
+from swarmtopo.experiments.sweep import stripped_log
 from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.sim import simulate
 
@@ -33,11 +32,8 @@ BUDGET = "400 x 60 s"
 def _run(task):
     cell_index, index, duration, cap = task
     cell = CELLS[cell_index]
-    with tuning_session():
-        arena_table, seed = case(cell, "tuning", index)
-    streams = case_streams(seed)
-    arena = build_arena(arena_table, streams["arena"])
-    log = stripped_log(simulate(arena, cell.agents, duration, rng=streams["simulation"]).log)
+    _, seed, arena, stream = tuning_arena(cell, index)
+    log = stripped_log(simulate(arena, cell.agents, duration, rng=stream).log)
     out = []
     for max_windows in (None, cap):
         start = time.perf_counter()

@@ -21,9 +21,8 @@ from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
 from swarmtopo.cycles import event_positions
-from swarmtopo.experiments.accuracy import CELLS, case, tuning_session
-from swarmtopo.experiments.grid import case_streams
-from swarmtopo.experiments.sweep import build_arena, stripped_log
+from swarmtopo.experiments.accuracy import CELLS, tuning_arena
+from swarmtopo.experiments.sweep import stripped_log
 from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.sim import simulate
 
@@ -58,11 +57,8 @@ def geodesic_distances(arena, points: np.ndarray, step: float = GRID_MM) -> np.n
 
 def landmark_pairs(cell, index: int):
     """(d, g, dt) of every pair of landmarks of the first window of one tuning case's map."""
-    with tuning_session():
-        table, seed = case(cell, "tuning", index)
-    streams = case_streams(seed)
-    arena = build_arena(table, streams["arena"])
-    sim = simulate(arena, cell.agents, cell.duration, rng=streams["simulation"], truth=True)
+    _, seed, arena, stream = tuning_arena(cell, index)
+    sim = simulate(arena, cell.agents, cell.duration, rng=stream, truth=True)
     log = stripped_log(sim.log)
     window = map_encounters(log, MapConfig(seed=seed % 2**32, embed_dim=0, cycles=False)).regions[0].windows[0]
     events = window.landmark_events

@@ -28,7 +28,8 @@ import argparse
 
 from swarmtopo.classify import load_classifier
 from swarmtopo.ratio import RatioClassifier, RatioThresholds
-from swarmtopo.experiments.accuracy import CELLS, PIPELINES, accuracy_table, beta1_misses, outcomes, reliability
+from swarmtopo.experiments.accuracy import (CELLS, PIPELINES, accuracy_table, beta1_misses, most_windows, outcomes,
+                                            reliability)
 from swarmtopo.experiments.store import read_jobs
 from swarmtopo.experiments.sweep import map_input
 
@@ -51,7 +52,7 @@ def main() -> None:
                         help="classifier presets or JSON files (default: the shipped one)")
     args = parser.parse_args()
     rows = default_rows(args.store)
-    print(f"{args.store}: {len(rows)} default-pipeline maps")
+    print(f"{args.store}: {len(rows)} default-pipeline maps, at most {most_windows(rows)} windows per region")
     for name in args.classifier:
         records = outcomes(rows, _classifier(name))
         table, rel = accuracy_table(records), reliability(records, 1)

@@ -23,7 +23,7 @@ import time
 
 from swarmtopo.classify import load_classifier
 from swarmtopo.experiments.accuracy import (CELLS, PIPELINES, QUICK_PER_CELL, REPORTING_PER_CELL, accuracy_table,
-                                            beta1_misses, outcomes, rate_text, reliability, reporting_jobs)
+                                            beta1_misses, most_windows, outcomes, rate_text, reliability, reporting_jobs)
 from swarmtopo.experiments.store import read_jobs
 from swarmtopo.experiments.sweep import run_sweep
 
@@ -55,6 +55,7 @@ def main() -> None:
     print(f"{len(jobs)} contact-trace maps ({per_cell} per cell), {summary.run} run in "
           f"{(time.perf_counter() - start) / 60:.1f} min on {summary.workers} Dask workers")
     rows = _rows(args.store, jobs)  # each job's stored diagrams, read by each classifier (whatever the job ran)
+    print(f"at most {most_windows(rows)} windows per region")
     columns = {f"contact trace, {name} classifier": outcomes(rows, load_classifier(name)) for name in args.classifier}
     if args.compare:
         full = _rows(args.compare, reporting_jobs(per_cell, pipelines={"default": PIPELINES["default"]}))

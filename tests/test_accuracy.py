@@ -155,3 +155,19 @@ def test_contact_trace_keeps_only_the_encounters_and_maps_from_them():
     bogus = acc.reporting_jobs(1, pipelines={"bogus": {**trace_pipeline, "input": "video"}}, cells=acc.CELLS[3:4])
     with pytest.raises(ValueError, match="map input 'video' is not one of"):
         run_job(bogus[0])
+
+
+def test_most_windows_is_the_largest_region_of_the_stored_maps():
+    rows = [{"diagrams": [{"windows": [{}] * 3}, {"windows": [{}] * 5}]},
+            {"diagrams": None, "error": "too little data"}, {"diagrams": [{"windows": [{}] * 4}]}]
+    assert acc.most_windows(rows) == 5
+    assert acc.most_windows([]) == 0 and acc.most_windows(rows[1:2]) == 0
+
+
+def test_tuning_arena_is_the_tuning_case_built():
+    cell = next(c for c in acc.CELLS if c.name.startswith("2 holes"))
+    table, seed, arena, stream = acc.tuning_arena(cell, 3)
+    with acc.tuning_session():
+        assert (table, seed) == acc.case(cell, "tuning", 3)
+    assert arena.betti == (1, 2) and table["holes"] == 2
+    assert stream == acc.case_streams(seed)["simulation"]

@@ -209,16 +209,16 @@ def _parse_scales(text: Optional[str]):
 
 
 def _parse_max_windows(text: Optional[str]):
-    """A --max-windows value: a whole number >= 1 or 'none' (every window)."""
+    """A --max-windows value: 'none' (every window) or a whole number >= 1."""
     if text is None or text.strip().lower() == "none":
-        return text and "none"
+        return None if text is None else "none"
     try:
-        value = int(text)
+        whole = int(text) >= 1
     except ValueError:
-        value = 0
-    if value < 1:
+        whole = False
+    if not whole:
         raise typer.BadParameter(f"{text!r} is not a whole number >= 1 or 'none'")
-    return str(value)
+    return text
 
 
 @app.command("map", epilog="Example: swarmtopo map runs/two-holes --out runs/two-holes/map --metric hybrid --landmarks 300")
@@ -277,7 +277,7 @@ def map_command(
     """Map an encounter log folder: Betti numbers with confidence, diagrams and pictures."""
     from .classify import load_classifier
     from .io import read_log
-    from .pipeline import MapConfig, seconds_option, wall_follow_option
+    from .pipeline import MapConfig, max_windows_option, seconds_option, wall_follow_option
 
     _check_verbosity(quiet, verbose)
     if paper:
@@ -298,8 +298,7 @@ def map_command(
                        wall_follow_weight=wall_follow_option(wall_follow_weight),
                        window_length=seconds_option(window_length),
                        window_scales=window_scales or MapConfig.window_scales,
-                       max_windows=(MapConfig.max_windows if max_windows is None else
-                                    None if max_windows == "none" else int(max_windows)))
+                       max_windows=max_windows_option(max_windows))
     if verbose:
         _detail(f"log {log_dir}: {log.n_events} encounters of {log.n_agents} agents over {log.duration:g} s")
     tmap, written = _run_map(log, config, log_dir, out_dir, quiet, verbose, classifier=model)

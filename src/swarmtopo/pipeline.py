@@ -86,6 +86,14 @@ def wall_follow_option(value: str | float | None) -> float | None:
     return None if value == "none" else float(value)
 
 
+def max_windows_option(value: str | int | None) -> int | None:
+    """``MapConfig.max_windows`` from a command-line value: None -> the default
+    (``MAX_WINDOWS``), "none" -> None (every window), a whole number -> that cap."""
+    if value is None:
+        return MAX_WINDOWS
+    return None if value == "none" else int(value)
+
+
 STAGES = ("graph", "landmarks", "persistence", "embedding", "classify", "cycles")
 """Stage names passed to ``map_encounters``'s progress callback, in order."""
 
@@ -677,15 +685,13 @@ def _shares(sizes: np.ndarray, cap: int) -> np.ndarray:
     after the floors going to the largest remainders."""
     if cap < np.count_nonzero(sizes):
         raise SwarmtopoError(f"a cap of {cap} windows cannot keep one of each of {np.count_nonzero(sizes)} lengths")
-    quota = cap * sizes / sizes.sum()
-    keep = np.minimum(np.maximum(np.floor(quota).astype(int), (sizes > 0).astype(int)), sizes)
+    quota = cap * sizes / sizes.sum()  # each below its size, as cap < sizes.sum()
+    keep = np.maximum(np.floor(quota).astype(int), sizes > 0)
     while keep.sum() > cap:  # the minimum of one pushed the floors over the cap
         keep[np.argmax(np.where(keep > 1, keep - quota, -np.inf))] -= 1
-    for i in np.argsort(-(quota - keep), kind="stable"):
-        if keep.sum() == cap:
-            break
-        if keep[i] < sizes[i]:
-            keep[i] += 1
+    # under the cap only if nothing was taken back: every remainder < 1, so each seat
+    # goes to a different group and none passes its size
+    keep[np.argsort(-(quota - keep), kind="stable")[:cap - keep.sum()]] += 1
     return keep
 
 

@@ -141,6 +141,16 @@ def case(cell: Cell, split: str, index: int) -> tuple[dict[str, Any], int]:
     raise SwarmtopoError(f"{SUITE}: no placeable arena for {cell.name} case {index} in {MAX_ATTEMPTS} attempts")
 
 
+def tuning_arena(cell: Cell, index: int):
+    """(arena table, case seed, built arena, simulation stream) of tuning case ``index``
+    of ``cell``, opened inside :func:`tuning_session` (the benchmark scripts that
+    simulate tuning cases themselves: ``benchmarks/levers.py`` and others)."""
+    with tuning_session():
+        table, seed = case(cell, "tuning", index)
+    streams = case_streams(seed)
+    return table, seed, build_arena(table, streams["arena"]), streams["simulation"]
+
+
 def _jobs(split: str, per_cell: int, pipelines: dict[str, dict[str, Any]], cells=CELLS) -> list[Job]:
     jobs = []
     for cell, index in ((cell, index) for cell in cells for index in range(per_cell)):
@@ -258,6 +268,13 @@ def beta1_misses(records: list[dict[str, Any]]) -> tuple[int, int]:
     mapped = [r for r in records if r["est_betti1"] is not None]
     return (sum(r["est_betti1"] > r["true_betti1"] for r in mapped),
             sum(r["est_betti1"] < r["true_betti1"] for r in mapped))
+
+
+def most_windows(rows: list[dict[str, Any]]) -> int:
+    """The most time windows any region of these stored maps pooled (their ``diagrams``;
+    0 without a map): what ``MapConfig.max_windows`` must stay above to leave them alone."""
+    return max((len(region["windows"]) for row in rows if row.get("diagrams") for region in row["diagrams"]),
+               default=0)
 
 
 def rate_text(rate: dict[str, Any]) -> str:

@@ -113,14 +113,22 @@ def fit_thresholds(maps: Sequence[TuningMap], pooling: str = "mean") -> Fit:
                surface=surface, pooling=pooling)
 
 
-def cross_validated(maps: Sequence[TuningMap], pooling: str = "mean", folds: int = 4) -> int:
-    """Exact maps when each fold (maps split by position) is read with the thresholds
-    fitted on the other folds: the fitted count without its in-sample optimism."""
+def cross_validated_exact(maps: Sequence[TuningMap], pooling: str = "mean", folds: int = 4) -> np.ndarray:
+    """Whether each map is exactly right when its fold (maps split by position) is read
+    with the thresholds fitted on the other folds."""
     fold = np.arange(len(maps)) % folds
-    return sum(int(exact([m for m, f in zip(maps, fold) if f == k],
-                         fit_thresholds([m for m, f in zip(maps, fold) if f != k], pooling).thresholds,
-                         pooling).sum())
-               for k in range(folds))
+    right = np.zeros(len(maps), bool)
+    for k in range(folds):
+        held = np.flatnonzero(fold == k)
+        th = fit_thresholds([m for m, f in zip(maps, fold) if f != k], pooling).thresholds
+        right[held] = exact([maps[i] for i in held], th, pooling)
+    return right
+
+
+def cross_validated(maps: Sequence[TuningMap], pooling: str = "mean", folds: int = 4) -> int:
+    """Exact maps, each fold read with the thresholds fitted on the other folds
+    (:func:`cross_validated_exact`): the fitted count without its in-sample optimism."""
+    return int(cross_validated_exact(maps, pooling, folds).sum())
 
 
 def cross_fitted_features(maps: Sequence[TuningMap], pooling: str = "mean",
