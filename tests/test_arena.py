@@ -129,7 +129,16 @@ BAD_GEOJSON = {
     "not an object": ([1, 2], "no 'type' member"),
     "flat coordinates": ({"type": "Polygon", "coordinates": [[0, 0], [1, 1]]}, "malformed coordinates"),
     "text coordinate": ({"type": "Polygon", "coordinates": [[["a", 0], [1, 0], [1, 1], [0, 0]]]},
-                        "malformed coordinates"),
+                        "coordinate 'a' is not a number"),
+    "numeric text": ({"type": "Polygon", "coordinates": [[["0", 0], [9, 0], [9, 9], [0, 0]]]},
+                     "coordinate '0' is not a number"),
+    "boolean coordinate": ({"type": "Polygon", "coordinates": [[[False, 0], [9, 0], [9, 9], [0, 0]]]},
+                           "coordinate False is not a number"),
+    "null coordinate": ({"type": "Polygon", "coordinates": [[[None, 0], [9, 0], [9, 9], [0, 0]]]},
+                        "coordinate None is not a number"),
+    "feet": ({"type": "Feature", "properties": {"units": "ft"},
+              "geometry": {"type": "Polygon", "coordinates": [[[0, 0], [9, 0], [9, 9], [0, 0]]]}},
+             "properties.units 'ft' is not supported; expected one of mm, cm, m"),
     "two points": ({"type": "Polygon", "coordinates": [[[0, 0], [1, 0]]]}, "malformed coordinates"),
     "no coordinates": ({"type": "Polygon"}, "Polygon has no 'coordinates'"),
     "feature without geometry": ({"type": "Feature", "geometry": None}, "Feature has no geometry"),
@@ -415,3 +424,56 @@ def test_geojson_file_round_trip(tmp_path):
     with pytest.raises(ArenaError) as info:
         read_arena(tmp_path / "bad.geojson")
     assert info.value.file == str(tmp_path / "bad.geojson")
+
+
+@pytest.mark.parametrize("units, mm", [("mm", 1.0), ("cm", 10.0), ("m", 1000.0)])
+def test_geojson_units_are_converted_to_mm(units, mm):
+    square = [[[0, 0], [0.5, 0], [0.5, 0.5], [0, 0.5], [0, 0]]]
+    feature = {"type": "Feature", "properties": {"units": units}, "geometry": {"type": "Polygon", "coordinates": square}}
+    arena = Arena.from_geojson(feature)
+    assert arena.area == pytest.approx(0.25 * mm ** 2) and arena.bounds == pytest.approx((0, 0, 0.5 * mm, 0.5 * mm))
+    collection = {"type": "FeatureCollection", "features": [feature]}
+    assert Arena.from_geojson(collection) == arena
+
+
+def test_a_nan_coordinate_is_refused_without_a_shapely_warning(recwarn):
+    with pytest.raises(ArenaError, match="non-finite coordinate"):
+        Arena.from_geojson({"type": "Polygon", "coordinates": [[[0, 0], [9, 0], [9, float("nan")], [0, 9], [0, 0]]]})
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
+
+
+def test_narrow_passages_are_the_hole_gaps_below_the_width():
+    holes = [box(5, 200, 105, 300), box(200, 200, 300, 300), box(315, 200, 415, 300)]
+    arena = Arena(Polygon(box(0, 0, 500, 500).exterior, [h.exterior for h in holes]))
+    assert arena.narrow_passages(30.0) == ["region 0: hole 0 is 5 mm from the outer wall",
+                                           "region 0: hole 2 is 15 mm from hole 1"]
+    assert arena.narrow_passages(10.0) == ["region 0: hole 0 is 5 mm from the outer wall"]
+    assert arena.narrow_passages(5.0) == [] and square_arena(500.0).narrow_passages(1e6) == []
+
+
+def test_a_room_inside_a_hole_is_drawn_as_free_space():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from swarmtopo.plotting import plot_arena
+
+    arena = Arena(MultiPolygon([Polygon(box(0, 0, 600, 600).exterior, [box(150, 150, 450, 450).exterior]),
+                                box(250, 250, 350, 350)]))
+    fig, ax = plt.subplots(figsize=(4, 4), dpi=50)
+    plot_arena(arena, ax)
+    ax.set_axis_off()
+    ax.set_position([0, 0, 1, 1])
+    ax.set_xlim(0, 600)
+    ax.set_ylim(0, 600)
+    fig.canvas.draw()
+    pixels = np.asarray(fig.canvas.buffer_rgba())[..., :3] / 255.0
+    plt.close(fig)
+
+    def grey_at(x, y):  # data (mm) -> pixel; the image's rows run top-down
+        h, w = pixels.shape[:2]
+        return pixels[int((1 - y / 600) * (h - 1)), int(x / 600 * (w - 1))].mean()
+
+    assert grey_at(300, 300) == pytest.approx(0.93, abs=0.02)  # the island: free space
+    assert grey_at(200, 300) == pytest.approx(0.45, abs=0.02)  # the hole round it
+    assert grey_at(75, 75) == pytest.approx(0.93, abs=0.02)  # the outer room

@@ -160,6 +160,43 @@ def test_bad_option_values(simulated, tmp_path):
                           "unknown metric 'euclid'")
     assert_one_line_error(run("map", simulated[0], "--window", "abc"), "T0:T1", code=2)
     assert_one_line_error(run("simulate", "--format", "xml", "--out", tmp_path / "y"), "xml", code=2)
+    for command in (["map", simulated[0]], ["simulate", "--out", tmp_path / "z"], ["demo", "--out", tmp_path / "w"]):
+        assert_one_line_error(run(*command, "--seed", -1), "--seed", code=2)
+    assert_one_line_error(run("simulate", "--out", tmp_path / "z", "--static-time", 3), "--static-fraction", code=2)
+    for option, value in (("--dt", 0), ("--rd", -1), ("--duration", "inf"), ("--trajectories", 0)):
+        assert_one_line_error(run("simulate", "--out", tmp_path / "z", option, value), f"'{option}'", code=2)
+    assert_one_line_error(run("plan", "--area", 0, "--agents", 200, "--duration", 30), "'--area'", code=2)
+    assert not (tmp_path / "z").exists()
+
+
+def test_simulate_replaces_a_log_only_with_overwrite(tmp_path):
+    folder = tmp_path / "deployment"
+    folder.mkdir()
+    (folder / "events.csv").write_text("t,a,b\n1,x,y\n")
+    (folder / "notes.txt").write_text("mine")
+    assert_one_line_error(run("simulate", "--agents", 20, "--duration", 1, "--out", folder, "--format", "parquet"),
+                          f"{folder}: already holds a log (events.csv); pass --overwrite")
+    assert (folder / "events.csv").read_text() == "t,a,b\n1,x,y\n"
+    proc = run("simulate", "--agents", 20, "--duration", 1, "--out", folder, "--format", "parquet", "--overwrite")
+    assert proc.returncode == 0 and f"removed the outdated {folder / 'events.csv'}" in proc.stdout
+    assert sorted(p.name for p in folder.iterdir()) == ["arena.geojson", "events.parquet", "meta.json", "notes.txt",
+                                                         "status.parquet"]
+
+
+def test_too_little_data_names_the_log_folder(tmp_path):
+    folder = tmp_path / "tiny"
+    assert run("simulate", "--agents", 4, "--duration", 1, "--out", folder, "-q").returncode == 0
+    assert_one_line_error(run("map", folder, "--out", tmp_path / "m"), f"{folder}: the log has 1 event(s)")
+
+
+def test_simulate_warns_of_passages_narrower_than_r_d(tmp_path):
+    arena = tmp_path / "gap.geojson"
+    arena.write_text(json.dumps({"type": "Polygon", "coordinates": [
+        [[0, 0], [500, 0], [500, 500], [0, 500], [0, 0]], [[5, 200], [105, 200], [105, 300], [5, 300], [5, 200]]]}))
+    proc = run("simulate", "--arena", arena, "--agents", 20, "--duration", 1, "--out", tmp_path / "log")
+    assert proc.returncode == 0 and proc.stderr.strip() == (
+        "warning: region 0: hole 0 is 5 mm from the outer wall, less than r_d = 30 mm: the swarm may not tell them "
+        "apart, and the map may miss that hole")
 
 
 @pytest.mark.parametrize("command", ["simulate", "ingest", "map", "demo", "sweep", "reproduce"])

@@ -58,8 +58,8 @@ def test_sociopatterns_window_length_is_configurable(tmp_path):
     ("nan 1 2 A B", "t", "nan", "time is not a number"),
     ("10 1 2 A B", "t", "10", "time is less than the window"),
     ("60 2 2 B B", "j", "2", "an agent cannot encounter itself"),
-    ("80 1", "fields", "2", "expected 3 or 5 fields"),
-    ("80 1 2 A", "fields", "4", "expected 3 or 5 fields"),
+    ("80 1", None, "80 1", "expected 3 or 5 fields"),
+    ("80  1 2\tA", None, "80 1 2 A", "expected 3 or 5 fields"),
 ])
 def test_sociopatterns_malformed_line_names_file_line_field_and_value(tmp_path, line, column, value, reason):
     path = write(tmp_path, "tij.dat", f"20 1 2 A B\n40 1 2 A B\n{line}\n60 1 2 A B\n")
@@ -107,8 +107,8 @@ def test_one_encounter_at_each_up_that_opens_a_connection(tmp_path):
             "10 CONN 2 3 down\n")  # same time, later line: closes it
     log, report = ingest(write(tmp_path, "one.txt", text), "one")
     assert events(log) == [(0.0, "1", "2"), (8.0, "1", "2"), (10.0, "2", "3")]
-    assert report.counts == {"blank_lines": 0, "other_events": 1, "repeated_up": 1, "unmatched_down": 1,
-                             "open_at_end": 1}
+    assert report.counts == {"blank_lines": 0, "other_events": 1, "repeated_up": 1, "reopened_at_once": 0,
+                             "unmatched_down": 1, "open_at_end": 1}
 
 
 def test_one_bad_state_is_malformed(tmp_path):
@@ -197,7 +197,7 @@ def test_cli_ingest_then_map(tmp_path):
     trace = write(tmp_path, "tij.dat", "\n".join(lines) + "\nbroken line\n")
     out = tmp_path / "log"
     bad = run_cli("ingest", trace, "--format", "sociopatterns", "--out", out)
-    assert bad.returncode == 1 and "row 799" in bad.stderr and "'fields'" in bad.stderr
+    assert bad.returncode == 1 and "row 799" in bad.stderr and "'broken line'" in bad.stderr
     ok = run_cli("ingest", trace, "--format", "sociopatterns", "--out", out, "--skip-bad")
     assert ok.returncode == 0, ok.stderr
     assert "skipped 1 malformed line(s)" in ok.stdout
@@ -249,3 +249,146 @@ def test_trace_without_encounters_is_refused(tmp_path):
 def test_cli_ingest_help_shows_an_example():
     result = run_cli("ingest", "--help")
     assert result.returncode == 0 and "Example: swarmtopo ingest" in result.stdout
+
+
+# -- traces as they come from the field ------------------------------------------------------
+def test_ingest_refuses_to_overwrite_its_own_trace_and_says_what_it_removes(tmp_path):
+    folder = tmp_path / "run"
+    folder.mkdir()
+    trace = folder / "events.parquet"
+    pq.write_table(pa.table({"t": [1.0, 2.0], "a": [1, 2], "b": [2, 3]}), trace)
+    refused = run_cli("ingest", trace, "--format", "parquet", "--out", folder, "--overwrite")  # never the trace
+    assert refused.returncode == 1 and "write the log to another folder" in refused.stderr
+    assert "Traceback" not in refused.stderr and trace.is_file() and not (folder / "events.csv").exists()
+    other = tmp_path / "log"
+    assert run_cli("ingest", trace, "--format", "parquet", "--out", other, "--log-format", "parquet").returncode == 0
+    kept = run_cli("ingest", trace, "--format", "parquet", "--out", other)  # a log is there: not without --overwrite
+    assert kept.returncode == 1 and "already holds a log (events.parquet, meta.json); pass --overwrite" in kept.stderr
+    again = run_cli("ingest", trace, "--format", "parquet", "--out", other, "--overwrite")  # CSV: the Parquet goes
+    assert again.returncode == 0 and f"removed the outdated {other / 'events.parquet'}" in again.stdout
+    assert sorted(p.name for p in other.iterdir()) == ["events.csv", "meta.json"]
+
+
+@pytest.mark.parametrize("column, seconds", [
+    (pa.array([10_000, 20_000], pa.duration("ms")), [10.0, 20.0]),
+    (pa.array([1_400_000_000_000_000_000, 1_400_000_020_500_000_000], pa.timestamp("ns", tz="UTC")),
+     [1_400_000_000.0, 1_400_000_020.5]),
+    (pa.array([16_000, 16_001], pa.date32()), [16_000 * 86400.0, 16_001 * 86400.0]),
+])
+def test_parquet_date_and_time_columns_become_seconds(tmp_path, column, seconds):
+    path = tmp_path / "trace.parquet"
+    pq.write_table(pa.table({"t": column, "a": [1, 2], "b": [2, 3]}), path)
+    log, _ = ingest(path, "parquet")
+    assert log.t.tolist() == seconds and str(column.type) in log.meta["ingest"]["time_type"]
+
+
+def test_times_of_2_to_the_53_seconds_or_more_are_refused_as_another_unit(tmp_path):
+    ns = pa.array([1_400_000_000_000_000_000, 1_400_000_020_000_000_000], pa.int64())
+    pq.write_table(pa.table({"t": ns, "a": [1, 2], "b": [2, 3]}), tmp_path / "ns.parquet")
+    with pytest.raises(InputError, match="2\\^53 s or more") as caught:
+        ingest(tmp_path / "ns.parquet", "parquet")
+    assert (caught.value.row, caught.value.column) == (1, "t")
+    path = write(tmp_path, "ns.csv", "t,a,b\n1,1,2\n1400000000000000001,1,2\n")
+    with pytest.raises(InputError, match="2\\^53 s or more") as caught:
+        ingest(path, "csv")
+    assert caught.value.row == 2
+    folder = tmp_path / "log"  # a log folder written by another tool: map refuses it in one line
+    folder.mkdir()
+    pq.write_table(pa.table({"t": ns, "a": [1, 2], "b": [2, 3]}), folder / "events.parquet")
+    mapped = run_cli("map", folder)
+    assert mapped.returncode == 1 and "2^53 s or more" in mapped.stderr and "Traceback" not in mapped.stderr
+
+
+def test_a_column_named_twice_is_refused_in_csv_and_parquet(tmp_path):
+    path = write(tmp_path, "trace.csv", "t,a,b,a\n1,x,y,z\n")
+    with pytest.raises(InputError, match="column appears twice: 'a'"):
+        ingest(path, "csv")
+    table = pa.table([pa.array([1.0]), pa.array([1]), pa.array([2]), pa.array([7])], names=["t", "a", "b", "a"])
+    pq.write_table(table, tmp_path / "trace.parquet")
+    with pytest.raises(InputError, match="column appears twice: 'a'"):
+        ingest(tmp_path / "trace.parquet", "parquet")
+
+
+def test_parquet_nulls_and_nan_ids_are_missing_values_and_text_is_kept_exactly(tmp_path):
+    path = tmp_path / "trace.parquet"
+    pq.write_table(pa.table({"t": [1.0, None, 3.0], "a": [1, None, 3], "b": [2, None, 1]}), path)
+    with pytest.raises(InputError, match="time is missing") as caught:  # not a blank line
+        ingest(path, "parquet")
+    assert caught.value.row == 2
+    pq.write_table(pa.table({"t": [1.0, 2.0], "a": [1.0, float("nan")], "b": [2.0, 3.0]}), path)
+    with pytest.raises(InputError, match="agent ID is missing") as caught:
+        ingest(path, "parquet")
+    assert (caught.value.row, caught.value.column) == (2, "a")
+    pq.write_table(pa.table({" t": [1.0, 2.0], "a ": [" 1", "1 "], "b": ["2", "2"]}), path)
+    log, _ = ingest(path, "parquet")  # names found as in CSV headers; values not trimmed: two agents
+    assert events(log) == [(1.0, " 1", "2"), (2.0, "1 ", "2")]
+
+
+def test_duplicate_events_quote_both_file_rows_and_the_exact_time(tmp_path):
+    path = write(tmp_path, "trace.csv", "t,a,b\n5,7,8\n\n6,x,x\n1400028780,1,2\n1400028780,2,1\n")
+    with pytest.raises(InputError) as caught:
+        ingest(path, "csv", skip_bad=True)
+    assert caught.value.row == 5 and "as row 4" in str(caught.value)
+    assert caught.value.value == "1400028780, 1, 2"
+
+
+def test_one_flapping_connection_at_one_time_is_one_encounter_and_a_bad_kind_is_malformed(tmp_path):
+    path = write(tmp_path, "one.txt", "0 CONN 1 2 up\n9.5 CONN 1 2 down\n9.5 CONN 1 2 up\n9.5 CONN 1 2 down\n"
+                                      "9.5 CONN 1 2 up\n")
+    log, report = ingest(path, "one")
+    assert events(log) == [(0.0, "1", "2"), (9.5, "1", "2")] and report.counts["reopened_at_once"] == 1
+    path = write(tmp_path, "typo.txt", "0 CONN 1 2 up\n3 CON 1 2 down\n4 M1 3 4 x\n")
+    with pytest.raises(InputError, match="event kind must be CONN") as caught:
+        ingest(path, "one")
+    assert (caught.value.row, caught.value.value) == (2, "CON")
+
+
+@pytest.mark.parametrize("raw", [
+    b"\xef\xbb\xbf20 1 2\n40 2 3\n",  # UTF-8 byte order mark
+    b"20 1 2\r40 2 3\r",  # CR-only line ends
+    b"20 1 2\r\n40 2 3",  # CRLF, no final line end
+])
+def test_sociopatterns_text_as_editors_save_it(tmp_path, raw):
+    log, report = ingest(write(tmp_path, "tij.dat", raw, "wb"), "sociopatterns")
+    assert events(log) == [(0.0, "1", "2"), (20.0, "2", "3")] and report.lines == 2
+
+
+def test_gzipped_text_traces_are_read_whatever_their_name(tmp_path):
+    import gzip
+    path = tmp_path / "tij.dat"
+    path.write_bytes(gzip.compress(b"20 1 2\n40 2 3\n"))
+    log, _ = ingest(path, "sociopatterns")
+    assert events(log) == [(0.0, "1", "2"), (20.0, "2", "3")]
+
+
+def test_crlf_split_across_blocks_is_one_line_end(tmp_path, monkeypatch):
+    raw = b"".join(f"{20 * k} {k % 7} {7 + k % 5}\r\n".encode() for k in range(1, 200))
+    path = write(tmp_path, "tij.dat", raw, "wb")
+    whole, whole_report = ingest(path, "sociopatterns")
+    for block in (5, 13, 14, 15):  # cuts before, at and after the \r\n of a 14-15 byte line
+        monkeypatch.setattr("swarmtopo.ingest._BLOCK", block)
+        small, small_report = ingest(path, "sociopatterns")
+        assert events(small) == events(whole) and small_report == whole_report
+    assert whole_report.lines == 199 and whole_report.counts["blank_lines"] == 0
+
+
+def test_not_utf8_mask_agrees_with_decoding_each_value():
+    from swarmtopo.ingest import _not_utf8
+    values = [b"ok", b"Cr\xe8che", None, "é".encode(), b"\xff", b""] * 50
+    expected = [v is not None and not _decodes_literally(v) for v in values]
+    assert _not_utf8(pa.array(values, pa.binary())).tolist() == expected
+
+
+def _decodes_literally(value: bytes) -> bool:
+    try:
+        value.decode("utf-8")
+    except UnicodeDecodeError:
+        return False
+    return True
+
+
+def test_minus_zero_is_not_the_integer_zero_and_a_folder_is_not_a_trace(tmp_path):
+    log, _ = ingest(write(tmp_path, "trace.csv", "t,a,b\n1,0,1\n2,-0,1\n"), "csv")
+    assert sorted(map(str, log.agent_ids)) == ["-0", "0", "1"]
+    with pytest.raises(InputError, match="is a folder, not a trace file"):
+        ingest(tmp_path, "csv")

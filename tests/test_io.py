@@ -30,7 +30,7 @@ from swarmtopo.io import (
 from swarmtopo.log import EncounterLog
 
 FORMATS = ["csv", "parquet"]
-AWKWARD_TIMES = [0.1, 1 / 3, 1e-300, 123456789.12345679, 5e-324, 2.0, 1e22, 0.30000000000000004]
+AWKWARD_TIMES = [0.1, 1 / 3, 1e-300, 123456789.12345679, 5e-324, 2.0, 2.0 ** 53 - 1, 0.30000000000000004]
 
 
 def make_log(ids="int", status=True, static=True, meta=None):
@@ -540,3 +540,45 @@ def test_a_million_csv_rows_read_fast(tmp_path, text):
     elapsed = time.perf_counter() - start
     assert log.n_events == 10**6 and np.array_equal(log.a, lo) and np.array_equal(log.b, hi)
     assert elapsed < 20.0  # about 1 s on an idle core; generous for a loaded 2-core machine
+
+
+@pytest.mark.parametrize("key, value, message", [
+    ("r_d", -1, "key 'r_d' must be a positive number"),
+    ("v_c", 0, "key 'v_c' must be a positive number"),
+    ("v_p", "fast", "key 'v_p' must be a positive number"),
+    ("dt", True, "key 'dt' must be a positive number"),
+    ("duration", -2.0, "key 'duration' must be a non-negative number"),
+    ("duration", 1.5, "key 'duration' is 1.5 s but the log runs to t = 3 s"),
+])
+def test_meta_numbers_that_cannot_be_are_refused(tmp_path, key, value, message):
+    log = EncounterLog.from_records([0.0, 1.0, 3.0], [1, 2, 1], [2, 3, 3], meta={"r_d": 30.0, "v_c": 15.0})
+    write_log(log, tmp_path)
+    meta = json.loads((tmp_path / "meta.json").read_text())
+    meta[key] = value
+    (tmp_path / "meta.json").write_text(json.dumps(meta))
+    with pytest.raises(InputError, match=message) as caught:
+        read_log(tmp_path)
+    assert caught.value.file == str(tmp_path / "meta.json")
+    meta[key] = 3.0  # a valid value of each key reads
+    (tmp_path / "meta.json").write_text(json.dumps(meta))
+    assert read_log(tmp_path).meta[key] == 3.0
+
+
+def test_log_files_that_are_folders_and_odd_meta_keys_are_refused(tmp_path):
+    log = EncounterLog.from_records([0.0, 1.0, 3.0], [1, 2, 1], [2, 3, 3])
+    write_log(log, tmp_path / "log")
+    with pytest.raises(InputError, match="is a file, not a log folder"):
+        read_log(tmp_path / "log" / "events.csv")
+    (tmp_path / "log" / "status.csv").mkdir()
+    with pytest.raises(InputError, match="is a folder, not a log file") as caught:
+        read_log(tmp_path / "log")
+    assert caught.value.file == str(tmp_path / "log" / "status.csv")
+    (tmp_path / "log" / "status.csv").rmdir()
+    meta_path = tmp_path / "log" / "meta.json"
+    for meta, message, value in [({"units": {"time": "ms"}}, "key 'units.time' must be \"s\"", "ms"),
+                                 ({"agent_ids": [1, 2, 3, 2]}, "lists an agent twice", 2),
+                                 ({"format": None}, "key 'format' is not", "null")]:
+        meta_path.write_text(json.dumps(meta))
+        with pytest.raises(InputError, match=message) as caught:
+            read_log(tmp_path / "log")
+        assert caught.value.value == value

@@ -106,6 +106,48 @@ def test_no_shared_agents_gets_a_clear_message():
         map_encounters(log)
 
 
+def test_encounters_all_at_one_time_get_a_clear_message():
+    pairs = [(a, b) for a in range(30) for b in range(a + 1, 30)]
+    log = EncounterLog.from_records([1.4e9] * len(pairs), *zip(*pairs))
+    with pytest.raises(SwarmtopoError, match="all 435 encounters are at one time \\(t = 1400000000 s\\)"):
+        map_encounters(log)
+
+
+def test_empty_windows_do_not_take_seats_under_the_cap():
+    # events in [0, 10] and [100, 110]: of the 10 s windows every 5 s, only those over a burst hold events
+    t = np.r_[np.linspace(0.0, 10.0, 50), np.linspace(100.0, 110.0, 50)]
+    spans, left_out = _scaled_windows(t, [10.0], cap=None, min_events=40)
+    assert spans == [(0.0, 10.0), (100.0, 110.0)] and left_out == 0
+    spans, left_out = _scaled_windows(t, [10.0], cap=2, min_events=40)  # all 21 windows would leave one burst out
+    assert spans == [(0.0, 10.0), (100.0, 110.0)] and left_out == 0
+
+
+def test_windows_too_short_to_list_are_refused_and_too_short_to_hold_a_region_say_so():
+    from swarmtopo.pipeline import MAX_WINDOWS_LISTED
+
+    with pytest.raises(SwarmtopoError, match="would be 799,999, more than 100,000: use longer windows"):
+        _windows(np.array([0.0, 40.0]), 1e-4)  # 1 + (40 - 1e-4) / 5e-5 windows
+    assert MAX_WINDOWS_LISTED == 100_000
+    log = simulate(default_arena(), 100, 10.0, rng=3).log
+    tmap = map_encounters(log, MapConfig(window_length=0.01, window_scales=(1.0,), **FAST))
+    assert tmap.regions[0].warnings[0] == ("no window (0.01 s long) holds 50 encounters of this region among 3 "
+                                           "agents: its whole log was mapped instead")
+    assert [(w.t0, w.t1) for w in tmap.regions[0].windows] == [(float(log.t.min()), float(log.t.max()))]
+
+
+def test_a_window_of_a_trace_takes_the_hop_cost_of_its_own_pace():
+    # agents meet every 1 s in [0, 100) and every 10 s in [100, 1100): h from the data follows the window
+    rng = np.random.default_rng(0)
+    t = np.r_[np.arange(0.0, 100.0, 0.05), np.arange(100.0, 1100.0, 0.5)]
+    a = rng.integers(0, 20, len(t))
+    b = (a + rng.integers(1, 20, len(t))) % 20
+    log = EncounterLog.from_records(t, a, b)
+    early = map_encounters(log, MapConfig(window=(0.0, 99.9), **FAST))
+    h, _ = resolve_hop_cost(log.window(0.0, 99.9), None)
+    assert early.to_json()["params"]["hop_cost_used"] == pytest.approx(h)
+    assert h < 0.5 * resolve_hop_cost(log, None)[0]
+
+
 def test_window_restricts_events():
     log = simulate(default_arena(), 200, 15.0, rng=1).log
     tmap = map_encounters(log, MapConfig(window=(2.0, 12.0), **FAST))

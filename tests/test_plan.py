@@ -124,4 +124,33 @@ def test_shipped_plan_was_fitted_on_the_full_benchmark():
     hi = max(n for n, _ in BUDGETS) / (500 * SCALE_RANGE[0]) ** 2
     assert lo * 0.99 <= model.density_range[0] and model.density_range[1] <= hi * 1.01
     assert model.duration_range == (min(t for _, t in BUDGETS), max(t for _, t in BUDGETS))
+    assert model.agents_range == (min(n for n, _ in BUDGETS), max(n for n, _ in BUDGETS))
     assert len(model.holes_mix) == 4 and model.holes_coef < 0  # 0-3 holes; more holes, harder
+
+
+def test_swarms_too_small_to_map_are_refused_and_sizes_outside_the_benchmark_are_extrapolations(tmp_path):
+    rng = np.random.default_rng(2)
+    records = synthetic_records(400, rng)
+    model = fit_plan(records, source="test")
+    assert model.agents_range == (min(r["agents"] for r in records), max(r["agents"] for r in records))
+    assert PlanModel.from_json(json.loads(json.dumps(model.to_json()))) == model
+    path = tmp_path / "plan.json"
+    path.write_text(json.dumps(model.to_json()))
+    small_room = ["plan", "--area", "20000", "--model", str(path)]  # a density inside the range, a tiny swarm
+    res = runner.invoke(app, small_room + ["--agents", "2", "--duration", "30"])
+    assert res.exit_code == 2 and "a map needs encounters among 3 agents or more" in res.output
+    res = runner.invoke(app, small_room + ["--agents", "5", "--duration", "30"])
+    assert res.exit_code == 0 and "outside the benchmark's range" in res.output
+    assert model.density_range[0] <= 5 / 20000 <= model.density_range[1]
+    res = runner.invoke(app, small_room + ["--duration", "80", "--target", "0.2"])
+    assert res.exit_code == 0 and "needed: 3 agents" in res.output and model.agents_for(20000, 80, 0.2) < 3
+
+
+@pytest.mark.parametrize("key, value", [("duration_range", [60]), ("density_range", [2e-3, 5e-4]),
+                                        ("agents_range", [0, 400]), ("duration_range", [30, float("inf")])])
+def test_a_plan_model_with_bad_ranges_is_refused(tmp_path, key, value):
+    obj = PlanModel(-3.0, 1.2, 1.8, (5e-4, 2e-3), (30, 60), 100, "test", -0.6, (0.25,) * 4, (200, 400)).to_json()
+    obj[key] = value
+    with pytest.raises(InputError, match="must be \\[low, high\\]") as caught:
+        PlanModel.from_json(obj, source="m.json")
+    assert (caught.value.file, caught.value.column) == ("m.json", key)

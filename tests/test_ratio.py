@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
 from swarmtopo.classify import load_classifier
@@ -146,9 +146,13 @@ bar_lists = st.lists(st.tuples(st.floats(0.1, 10), st.floats(0.01, 10)), max_siz
 @settings(max_examples=60, deadline=None)
 @given(bars=st.lists(bar_lists, min_size=1, max_size=4), c=st.floats(0.01, 100),
        tau=st.floats(1.0, 20.0), q=st.sampled_from([0.5, 0.7, 0.9]))
+@example(bars=[[(1.0, 1.0), (2.0, 1.0)]], c=0.01, tau=1.0, q=0.5)  # equal bars at tau = 1: assumed away
 def test_pooled_counts_are_scale_invariant_and_between_the_windows_counts(bars, c, tau, q):
     # multiplying every distance by c multiplies births and deaths by c
     h1s = [np.array([[b, b + length] for b, length in w]).reshape(-1, 2) for w in bars]
+    # a score on the threshold itself (tau = 1 and two equal bars) counts or not by rounding: not a case
+    scores = np.r_[pooled_scores(windows_of(*h1s), 1, q), *(window_scores(diagram(h), 1, q) for h in h1s)]
+    assume(not np.any(np.abs(scores - np.log(tau)) < 1e-9))
     model = RatioClassifier({1: RatioThresholds(q, tau)})
     pooled = model.pooled_betti(windows_of(*h1s))[1]
     assert pooled == model.pooled_betti(windows_of(*(h * c for h in h1s)))[1]
@@ -215,3 +219,21 @@ def test_shipped_default_is_a_calibrated_mean_pooled_ratio_classifier():
     model = load_classifier("default")
     assert isinstance(model, RatioClassifier) and model.pooling == "mean"
     assert model.calibration_.get("1") and model.beta0_confidence() is not None
+
+
+@pytest.mark.parametrize("key, value, message", [
+    ("rate", "high", "must be a finite number in \\[0, 1\\]"),
+    ("rate", 2.0, "must be a finite number in \\[0, 1\\]"),
+    ("rate", float("nan"), "must be a finite number in \\[0, 1\\]"),
+    ("maps", -1, "must be a finite number"),
+])
+def test_a_classifier_file_with_a_bad_calibration_is_refused_naming_the_file(tmp_path, key, value, message):
+    import json
+
+    obj = json.loads(json.dumps(load_classifier("default").to_json()))
+    obj["calibration"]["0"][key] = value
+    path = tmp_path / "c.json"
+    path.write_text(json.dumps(obj))
+    with pytest.raises(InputError, match=message) as caught:
+        load_classifier(path)
+    assert (caught.value.file, caught.value.column) == (str(path), f"calibration.0.{key}")

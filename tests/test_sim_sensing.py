@@ -146,3 +146,42 @@ def test_simulation_logs_initial_contacts_at_t0_per_flag(log_initial):
     assert len(initial) > 20
     got = set(zip(sim.log.a[at0].tolist(), sim.log.b[at0].tolist()))
     assert got == (initial if log_initial else set())
+
+
+def _literal_wall_grid_pairs(segs, bounds, cell, reach):
+    """Every cell of the bounding box tested against every segment (the definition)."""
+    import math
+
+    xmin, ymin, xmax, ymax = bounds
+    ncx, ncy = max(1, math.ceil((xmax - xmin) / cell)), max(1, math.ceil((ymax - ymin) / cell))
+    cy, cx = np.divmod(np.arange(ncx * ncy), ncx)
+    boxes = shapely.box(xmin + cx * cell, ymin + cy * cell, xmin + (cx + 1) * cell, ymin + (cy + 1) * cell)
+    lines = shapely.linestrings(np.asarray(segs, float).reshape(-1, 2, 2))
+    cell_id, seg_id = shapely.STRtree(lines).query(boxes, predicate="dwithin", distance=reach)
+    return sorted(zip(cell_id.tolist(), seg_id.tolist()))
+
+
+@pytest.mark.parametrize("seed, cell, reach", [(0, 30.0, 30.0), (1, 30.0, 34.5), (2, 17.0, 50.0), (3, 45.0, 10.0)])
+def test_wall_grid_lists_exactly_the_segments_within_reach_of_each_cell(seed, cell, reach):
+    from swarmtopo.arena import random_arena
+    from swarmtopo.sim.walls import build_wall_grid
+
+    arena = random_arena(3, rng=seed, shapes=("disc", "triangle", "wall", "L"), outer="polygon")
+    grid = build_wall_grid(arena.boundary_segments, arena.bounds, cell=cell, reach=reach)
+    pairs = sorted((c, int(grid.index[k])) for c in range(grid.ncx * grid.ncy)
+                   for k in range(grid.start[c], grid.start[c + 1]))
+    assert pairs == _literal_wall_grid_pairs(arena.boundary_segments, arena.bounds, cell, reach)
+
+
+def test_a_large_arena_builds_its_wall_grid_along_the_walls_and_an_absurd_one_is_refused():
+    from swarmtopo.arena import square_arena
+    from swarmtopo.errors import SwarmtopoError
+    from swarmtopo.sim.walls import MAX_WALL_CELLS, build_wall_grid
+
+    big = square_arena(100_000.0)  # 100 m: 11 million cells, of which only those along the walls are listed
+    grid = build_wall_grid(big.boundary_segments, big.bounds, cell=30.0, reach=30.0)
+    assert grid.ncx == grid.ncy == 3334 and 4 * 3334 <= len(grid.index) <= 4 * 3 * 3334
+    huge = square_arena(1e6)
+    with pytest.raises(SwarmtopoError, match="are its coordinates in mm"):
+        build_wall_grid(huge.boundary_segments, huge.bounds, cell=30.0, reach=30.0)
+    assert (1e6 / 30.0) ** 2 > MAX_WALL_CELLS

@@ -19,6 +19,7 @@ outer wall's bounding box at the origin, except :func:`annulus_arena`):
 
 from __future__ import annotations
 
+import warnings
 from functools import cached_property
 from typing import Any
 
@@ -142,6 +143,21 @@ class Arena:
             out = np.vstack([out, cand[keep]])
         return out[:n]
 
+    def narrow_passages(self, width: float) -> list[str]:
+        """The passages narrower than ``width`` (mm) between a hole and its outer wall or
+        another hole of its region, described ("region 0: hole 1 is 15 mm from the outer
+        wall"): a swarm whose agents sense each other across r_d may see such a hole as
+        part of the wall, or two such holes as one."""
+        found = []
+        for i, region in enumerate(self.regions):
+            walls = [("the outer wall", region.exterior)] + [(f"hole {j}", ring) for j, ring in enumerate(region.interiors)]
+            for k, (name, ring) in enumerate(walls[1:], 1):
+                for other, other_ring in walls[:k]:
+                    gap = ring.distance(other_ring)
+                    if gap < width:
+                        found.append(f"region {i}: {name} is {gap:.3g} mm from {other}")
+        return found
+
     def scaled(self, factor: float) -> "Arena":
         """The same arena scaled by ``factor`` (> 0) about the origin."""
         factor = positive("scale factor", factor)
@@ -172,13 +188,13 @@ class Arena:
                     raise ArenaError(f"feature {i} is not a GeoJSON Feature", file=source)
                 if not feat.get("geometry"):
                     raise ArenaError(f"feature {i} has no geometry", file=source)
-                geom = _geometry_from(feat["geometry"], source, f"feature {i}: ")
+                geom = _geometry_from(feat["geometry"], source, f"feature {i}: ", _units(feat, source, f"feature {i}: "))
                 polys.extend(geom.geoms if isinstance(geom, MultiPolygon) else [geom])
             return cls(MultiPolygon(polys), source=source)
         if kind == "Feature":
             if not obj.get("geometry"):
                 raise ArenaError("Feature has no geometry", file=source)
-            return cls(_geometry_from(obj["geometry"], source), source=source)
+            return cls(_geometry_from(obj["geometry"], source, "", _units(obj, source)), source=source)
         return cls(_geometry_from(obj, source), source=source)
 
     @cached_property
@@ -487,7 +503,32 @@ def _hole_shapes(shapes) -> tuple[str, ...]:
     return shapes
 
 
-def _geometry_from(obj, source, where: str = "") -> Polygon | MultiPolygon:
+MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0}
+"""Units a Feature's ``properties.units`` may name; coordinates are converted to mm."""
+
+
+def _units(feature: dict, source, where: str = "") -> float:
+    """mm per unit of a Feature's coordinates (``properties.units``; mm when absent)."""
+    properties = feature.get("properties")
+    units = properties.get("units", "mm") if isinstance(properties, dict) else "mm"
+    if units not in MM_PER_UNIT:
+        raise ArenaError(f"{where}properties.units {units!r} is not supported; expected one of "
+                         f"{', '.join(MM_PER_UNIT)}", file=source)
+    return MM_PER_UNIT[units]
+
+
+def _numbers_only(coordinates, source, where: str) -> None:
+    """Refuse a coordinate that is not a JSON number (text, true/false, null)."""
+    stack = [coordinates]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, list):
+            stack.extend(item)
+        elif isinstance(item, bool) or not isinstance(item, (int, float)):
+            raise ArenaError(f"{where}coordinate {item!r} is not a number", file=source)
+
+
+def _geometry_from(obj, source, where: str = "", mm_per_unit: float = 1.0) -> Polygon | MultiPolygon:
     if not isinstance(obj, dict):
         raise ArenaError(f"{where}geometry is not a GeoJSON object", file=source)
     kind = obj.get("type")
@@ -496,10 +537,14 @@ def _geometry_from(obj, source, where: str = "") -> Polygon | MultiPolygon:
                          file=source)
     if "coordinates" not in obj:
         raise ArenaError(f"{where}{kind} has no 'coordinates'", file=source)
+    _numbers_only(obj["coordinates"], source, where)
     try:
-        return shape(obj)
+        with warnings.catch_warnings():  # a NaN coordinate is refused by _validated, without shapely's warning
+            warnings.simplefilter("ignore", RuntimeWarning)
+            geometry = shape(obj)
     except Exception as exc:  # shapely raises several types on malformed coordinates
         raise ArenaError(f"{where}malformed coordinates ({exc})", file=source) from None
+    return geometry if mm_per_unit == 1.0 else shapely.affinity.scale(geometry, mm_per_unit, mm_per_unit, origin=(0, 0))
 
 
 def _validated(geometry, source) -> MultiPolygon:

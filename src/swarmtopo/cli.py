@@ -33,6 +33,26 @@ DEMO_AGENTS, DEMO_SECONDS = 200, 30.0
 VERBOSE_HELP = "Also report each stage's details and timings on stderr (in pipes too)."
 
 
+OVERWRITE_HELP = "Replace the log already in --out (its log files are replaced or removed)."
+
+
+def _write_log_folder(log, out_dir: Path, quiet: bool, overwrite: bool, **options) -> list[Path]:
+    """``io.write_log`` into a folder without a log, or over one with ``overwrite``,
+    saying which outdated log files of the folder it removed."""
+    from .io import log_files, write_log
+
+    before = set(log_files(out_dir))
+    if before and not overwrite:
+        names = ", ".join(sorted(p.name for p in before))
+        raise SwarmtopoError(f"{out_dir}: already holds a log ({names}); pass --overwrite to replace it, "
+                             f"or choose another --out")
+    written = write_log(log, out_dir, **options)
+    if not quiet:
+        for path in sorted(before - set(written)):
+            out.print(f"removed the outdated {path}", markup=False, highlight=False, soft_wrap=True)
+    return written
+
+
 def _check_verbosity(quiet: bool, verbose: bool) -> None:
     if quiet and verbose:
         raise typer.BadParameter("--quiet and --verbose exclude each other")
@@ -41,6 +61,19 @@ def _check_verbosity(quiet: bool, verbose: bool) -> None:
 def _detail(message: str) -> None:
     """One --verbose line on stderr."""
     err.print(message, markup=False, highlight=False, soft_wrap=True)
+
+
+def _positive_option(value: float | None) -> float | None:
+    """A finite number > 0 (None passes: the option was not given)."""
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise typer.BadParameter(f"{value:g} is not a finite number > 0")
+    return value
+
+
+def _finite_option(value: float | None) -> float | None:
+    if value is not None and not math.isfinite(value):
+        raise typer.BadParameter(f"{value:g} is not a finite number")
+    return value
 
 
 def _fmt_option(value: str) -> str:
@@ -68,16 +101,18 @@ def simulate(
     holes: int = typer.Option(1, "--holes", min=0, help="Without --arena: square holes of a random square arena."),
     scale: float = typer.Option(1.0, "--scale", min=0.05, help="Without --arena: scale of the random arena."),
     agents: int = typer.Option(200, "--agents", min=1, help="Swarm size N."),
-    duration: float = typer.Option(20.0, "--duration", min=0.0, help="Seconds of data."),
-    seed: int = typer.Option(0, "--seed", help="Random seed (same seed, same bytes)."),
+    duration: float = typer.Option(20.0, "--duration", min=0.0, callback=_finite_option, help="Seconds of data."),
+    seed: int = typer.Option(0, "--seed", min=0, help="Random seed (same seed, same bytes)."),
     static_fraction: float = typer.Option(0.0, "--static-fraction", min=0.0, max=1.0,
                                           help="Hybrid network: fraction of agents stopped for good."),
     static_time: float = typer.Option(0.0, "--static-time", min=0.0, help="When the static agents stop (s)."),
-    dt: float = typer.Option(0.1, "--dt", help="Time step (s); v_c*dt must stay <= r_d/4."),
-    rd: float = typer.Option(30.0, "--rd", help="Detection radius r_d (mm)."),
+    dt: float = typer.Option(0.1, "--dt", callback=_positive_option, help="Time step (s); v_c*dt must stay <= r_d/4."),
+    rd: float = typer.Option(30.0, "--rd", callback=_positive_option, help="Detection radius r_d (mm)."),
     truth: bool = typer.Option(False, "--truth", help="Also write truth.<fmt>: true positions per event."),
-    trajectories: Optional[float] = typer.Option(None, "--trajectories", help="Also write positions every EVERY s."),
+    trajectories: Optional[float] = typer.Option(None, "--trajectories", callback=_positive_option,
+                                                 help="Also write positions every EVERY s."),
     fmt: str = typer.Option("csv", "--format", callback=_fmt_option, help="csv or parquet."),
+    overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar, no summary."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
@@ -85,13 +120,18 @@ def simulate(
     import time
 
     from .arena import random_arena
-    from .io import read_arena, write_log
+    from .io import read_arena
     from .sim import SensingParams, simulate as run
 
     _check_verbosity(quiet, verbose)
+    if static_time > 0 and static_fraction == 0:
+        raise typer.BadParameter("the static agents' stop time needs --static-fraction > 0", param_hint="--static-time")
 
     # The arena draws from its own stream, spawned from the seed; the swarm uses the seed.
     world = read_arena(arena) if arena else random_arena(holes, scale=scale, rng=np.random.SeedSequence(seed).spawn(1)[0])
+    for passage in world.narrow_passages(rd):
+        _warn(f"{passage}, less than r_d = {rd:g} mm: the swarm may not tell them apart, and the map may miss "
+              f"that hole", quiet)
     if verbose:
         _detail(f"arena: {world.betti[0]} region(s), {world.betti[1]} hole(s), area {world.area:.0f} mm^2; "
                 f"{agents} agents, {duration:g} s, dt {dt:g} s, r_d {rd:g} mm, seed {seed}")
@@ -103,7 +143,8 @@ def simulate(
     if verbose:
         _detail(f"simulated in {time.perf_counter() - start:.2f} s: {sim.log.n_events} encounters, "
                 f"{len(sim.log.status_t)} status changes")
-    written = write_log(sim.log, out_dir, fmt=fmt, truth=sim.truth, trajectories=sim.trajectories, arena=world)
+    written = _write_log_folder(sim.log, out_dir, quiet, overwrite, fmt=fmt, truth=sim.truth,
+                                trajectories=sim.trajectories, arena=world)
     if not quiet:
         b0, b1 = world.betti
         out.print(f"{sim.log.n_events} encounters of {agents} agents over {duration:g} s "
@@ -126,24 +167,25 @@ def ingest(
     window: float = typer.Option(20.0, "--contact-window",
                                  help="sociopatterns: seconds of one contact window (a line at t covers (t-w, t])."),
     log_fmt: str = typer.Option("csv", "--log-format", callback=_fmt_option, help="Log folder tables: csv or parquet."),
+    overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
     """Convert a proximity trace into an encounter log folder (see docs/real-data.md)."""
     from .ingest import FORMATS, ingest as read_trace
-    from .io import write_log
+    from .log import exact_time
 
     _check_verbosity(quiet, verbose)
     if fmt not in FORMATS:
         raise typer.BadParameter(f"{fmt!r} is not one of {', '.join(FORMATS)}", param_hint="--format")
     log, report = read_trace(trace, fmt, skip_bad=skip_bad, time_column=time_column, a_column=a_column,
                              b_column=b_column, window=window)
-    written = write_log(log, out_dir, fmt=log_fmt)
+    written = _write_log_folder(log, out_dir, quiet, overwrite, fmt=log_fmt, protect=(trace,))
     if verbose:
         _detail(f"ingest report: {report.as_meta()}")
     if not quiet:
         out.print(f"{report.lines} lines of {trace}: {log.n_events} encounters of {log.n_agents} agents "
-                  f"over {log.duration:g} s", markup=False, highlight=False)
+                  f"from t = {exact_time(log.t[0])} to {exact_time(log.t[-1])} s", markup=False, highlight=False)
         if skip_bad:
             out.print(f"skipped {report.skipped} malformed line(s)", markup=False, highlight=False)
             for message in report.examples:
@@ -228,13 +270,13 @@ def map_command(
     metric: str = typer.Option("hybrid", "--metric", help="plain | contracted | hybrid (paper's metrics)."),
     subsample: str = typer.Option("maxmin", "--subsample", help="maxmin | knn | probabilistic."),
     landmarks: Optional[int] = typer.Option(
-        None, "--landmarks", min=3,
+        None, "--landmarks", min=3, max=10**9,
         help="Number of landmarks L per region and window (default: the fewest that meet the sampling "
              "guarantee, at most 400)."),
     window: Optional[str] = typer.Option(None, "--window", callback=_parse_window,
                                          help="Time window T0:T1 in seconds (either end may be empty)."),
     maxdim: int = typer.Option(1, "--maxdim", min=1, max=2, help="Highest homology dimension (1 or 2)."),
-    seed: int = typer.Option(0, "--seed", help="Seed of landmark start and MDS."),
+    seed: int = typer.Option(0, "--seed", min=0, help="Seed of landmark start and MDS."),
     hop_cost: Optional[float] = typer.Option(
         None, "--hop-cost", min=0.0,
         help="Per-hop cost h in seconds on the encounter graph; 0 = the paper's metric "
@@ -291,14 +333,16 @@ def map_command(
         hop_cost, diffusion_time, wall_follow_weight, window_length, classifier = 0.0, "none", "none", "none", "paper"
         window_scales = (1.0,)
     out_dir = out_dir or log_dir / "map"
-    model = load_classifier(classifier) if classifier else None  # None: the shipped one for the log
-    log = read_log(log_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise SwarmtopoError(f"{out_dir}: --out is a file; give a folder for the map's outputs")
     config = MapConfig(metric=metric, subsample=subsample, landmarks=landmarks, window=window, maxdim=maxdim,
                        seed=seed, hop_cost=hop_cost, diffusion_time=seconds_option(diffusion_time),
                        wall_follow_weight=wall_follow_option(wall_follow_weight),
                        window_length=seconds_option(window_length),
                        window_scales=window_scales or MapConfig.window_scales,
-                       max_windows=max_windows_option(max_windows))
+                       max_windows=max_windows_option(max_windows)).validate()
+    model = load_classifier(classifier) if classifier else None  # None: the shipped one for the log
+    log = read_log(log_dir)
     if verbose:
         _detail(f"log {log_dir}: {log.n_events} encounters of {log.n_agents} agents over {log.duration:g} s")
     tmap, written = _run_map(log, config, log_dir, out_dir, quiet, verbose, classifier=model)
@@ -310,7 +354,7 @@ def map_command(
 @app.command(epilog="Example: swarmtopo demo --out swarmtopo-demo")
 def demo(
     out_dir: Path = typer.Option(Path("swarmtopo-demo"), "--out", help="Output folder."),
-    seed: int = typer.Option(0, "--seed", help="Random seed."),
+    seed: int = typer.Option(0, "--seed", min=0, help="Random seed."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
@@ -467,10 +511,11 @@ def bench_accuracy(
     import time
 
     from .experiments.accuracy import markdown, run_benchmark
-    from .io import write_json
+    from .io import make_folder, write_json
     from .plan import fit_plan
 
     _check_verbosity(quiet, verbose)
+    make_folder(out_dir)  # before the hour of maps, not after
     command = "swarmtopo " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     start = time.perf_counter()
     try:
@@ -483,7 +528,6 @@ def bench_accuracy(
         raise typer.Exit(130) from None
     summary["wall_seconds"] = time.perf_counter() - start
     text = markdown(summary, command)
-    out_dir.mkdir(parents=True, exist_ok=True)
     written = [write_json({k: v for k, v in summary.items()}, out_dir / "accuracy.json")]
     (out_dir / "accuracy.md").write_text(text, encoding="utf-8")
     written.append(out_dir / "accuracy.md")
@@ -499,9 +543,9 @@ def bench_accuracy(
 @app.command(epilog="Examples: swarmtopo plan --area 250000 --agents 200 --duration 30;  "
                     "swarmtopo plan --area 250000 --agents 200 --target 0.95 --holes 3")
 def plan(
-    area: float = typer.Option(..., "--area", help="Area inside the outer walls, mm^2."),
+    area: float = typer.Option(..., "--area", callback=_positive_option, help="Area inside the outer walls, mm^2."),
     agents: Optional[int] = typer.Option(None, "--agents", min=1, help="Swarm size N."),
-    duration: Optional[float] = typer.Option(None, "--duration", help="Seconds of data T."),
+    duration: Optional[float] = typer.Option(None, "--duration", callback=_positive_option, help="Seconds of data T."),
     target: Optional[float] = typer.Option(None, "--target", help="Wanted exact-match accuracy, e.g. 0.95."),
     holes: Optional[int] = typer.Option(None, "--holes", min=0, help="Holes the arena is expected to have "
                                         "(default: averaged over the benchmark's mix of 0-3 holes)."),
@@ -514,8 +558,11 @@ def plan(
     for the other; --holes if you know how many holes to expect.  Answers come from the
     accuracy benchmark (docs/accuracy.md).
     """
+    from .pipeline import MIN_REGION_AGENTS
     from .plan import load_plan
 
+    if agents is not None and agents < MIN_REGION_AGENTS:
+        raise typer.BadParameter(f"a map needs encounters among {MIN_REGION_AGENTS} agents or more", param_hint="--agents")
     given = {"agents": agents is not None, "duration": duration is not None, "target": target is not None}
     if sum(given.values()) != 2:
         raise typer.BadParameter("give two of --agents, --duration and --target (the third is computed)")
@@ -527,20 +574,21 @@ def plan(
                   f"({agents} agents x {duration:g} s in {area:g} mm^2{with_holes})", markup=False, highlight=False)
         n, t = agents, duration
     elif agents is None:
-        n = model.agents_for(area, duration, target, holes)
+        n = max(model.agents_for(area, duration, target, holes), MIN_REGION_AGENTS)  # fewer cannot be mapped
         t = duration
-        out.print(_plan_answer("agents", n, f"for {100 * target:g}% in {duration:g} s over {area:g} mm^2{with_holes}"),
+        out.print(_plan_answer("agents", n, f"for {100 * target:.10g}% in {duration:g} s over {area:g} mm^2{with_holes}"),
                   markup=False, highlight=False)
     else:
         t = model.duration_for(area, agents, target, holes)
         n = agents
         out.print(_plan_answer("seconds of data", t,
-                               f"for {100 * target:g}% with {agents} agents over {area:g} mm^2{with_holes}"),
+                               f"for {100 * target:.10g}% with {agents} agents over {area:g} mm^2{with_holes}"),
                   markup=False, highlight=False)
     if np.isfinite(n) and np.isfinite(t) and not model.inside(area, n, t, holes):
         lo, hi = model.density_range
         t_lo, t_hi = model.duration_range
-        out.print(f"note: outside the benchmark's range ({lo * 1e6:.0f}-{hi * 1e6:.0f} agents per m^2, "
+        swarms = "" if model.agents_range is None else f"{model.agents_range[0]:g}-{model.agents_range[1]:g} agents, "
+        out.print(f"note: outside the benchmark's range ({swarms}{lo * 1e6:.0f}-{hi * 1e6:.0f} agents per m^2, "
                   f"{t_lo:g}-{t_hi:g} s, 0-{len(model.holes_mix) - 1} holes): an extrapolation",
                   markup=False, highlight=False)
 
@@ -560,8 +608,13 @@ def _run_map(log, config, log_dir: Path, out_dir: Path, quiet: bool, verbose: bo
     from .report import write_map_outputs
 
     with _progress("mapping", quiet) as tick:
-        tmap = map_encounters(log, config, classifier=classifier,
-                              progress=lambda stage: tick(STAGES.index(stage) / len(STAGES)))
+        try:
+            tmap = map_encounters(log, config, classifier=classifier,
+                                  progress=lambda stage: tick(STAGES.index(stage) / len(STAGES)))
+        except SwarmtopoError as exc:
+            if getattr(exc, "file", None):  # already names its file
+                raise
+            raise SwarmtopoError(f"{log_dir}: {exc}") from None
         tick(1.0)
     if verbose:
         _map_details(tmap)
@@ -632,7 +685,9 @@ def _print_verdict(tmap, truth) -> None:
         p = tmap.confidence.get(n)
         return "" if p is None else f" ({100 * p:.0f}% confidence)"
 
-    est = ", ".join(f"beta_{n} = {b}{confidence(n)}" for n, b in sorted(tmap.betti.items()))
+    est = ", ".join(f"beta_{n} = {b}{confidence(n)}" if b is not None else
+                    f"beta_{n} not estimated (the classifier has no threshold for it)"
+                    for n, b in sorted(tmap.betti.items()))
     out.print(f"recovered: {est}")
     if truth is not None:
         out.print(f"true:      beta_0 = {truth[0]}, beta_1 = {truth[1]}")

@@ -41,6 +41,7 @@ lines are not malformed: they are counted and ignored.
 
 from __future__ import annotations
 
+import gzip
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -51,8 +52,8 @@ import pyarrow.csv as pcsv
 import pyarrow.parquet as pq
 
 from .errors import InputError, SwarmtopoError
-from .io import _PLAIN_INTEGER, _first_uncastable
-from .log import EncounterLog
+from .io import _PLAIN_INTEGER
+from .log import MAX_TIME, TOO_LATE, EncounterLog
 
 FORMATS: tuple[str, ...] = ("csv", "parquet", "sociopatterns", "one")
 SOCIOPATTERNS_WINDOW = 20.0
@@ -122,14 +123,17 @@ def read_table_trace(path, *, fmt: str = "csv", skip_bad: bool = False, time_col
     names = {"t": time_column, "a": a_column, "b": b_column}
     rows = _Rows(str(path), skip_bad)
     for line, cols in (_csv_batches(path, names, rows) if fmt == "csv" else _parquet_batches(path, names, rows)):
-        blank = _blank_row(cols)
+        blank = _blank_row(cols) if fmt == "csv" else np.zeros(len(line), bool)  # Parquet has no blank lines
         rows.counts["blank_lines"] += int(blank.sum())
         line, cols = line[~blank], {k: v.filter(pa.array(~blank)) for k, v in cols.items()}
         t, ok = _times(cols["t"], line, names["t"], rows, minimum=0.0)
         ok &= _ids_ok(cols["a"], cols["b"], line, (names["a"], names["b"]), rows)
         rows.keep(ok, line, t=t[ok], a=cols["a"].filter(pa.array(ok)), b=cols["b"].filter(pa.array(ok)))
     t, a, b, line = rows.columns()
-    log = _build(t, a, b, line, rows, fmt, {"time": names["t"], "a": names["a"], "b": names["b"]})
+    columns = {"time": names["t"], "a": names["a"], "b": names["b"]}
+    if rows.time_type is not None:
+        columns["time_type"] = rows.time_type
+    log = _build(t, a, b, line, rows, fmt, columns)
     return log, rows.report(fmt)
 
 
@@ -141,7 +145,7 @@ def read_sociopatterns(path, *, window: float = SOCIOPATTERNS_WINDOW,
     path = _existing(path)
     rows = _Rows(str(path), skip_bad)
     for line, fields, n in _text_batches(path, rows):
-        ok = _field_count_ok(n, (3, 5), line, rows, "t i j Ci Cj (or t i j)")
+        ok = _field_count_ok(n, (3, 5), fields, line, rows, "t i j Ci Cj (or t i j)")
         t_col, a, b = (_field(fields, k, ok) for k in range(3))
         t, t_ok = _times(t_col, line, "t", rows, minimum=window, active=ok,
                          below=f"time is less than the window ({window:g} s): the contact would start before 0")
@@ -172,9 +176,12 @@ def read_one(path, *, skip_bad: bool = False) -> tuple[EncounterLog, IngestRepor
         has_kind = n >= 2
         kind = _field(fields, 1, has_kind)
         conn = has_kind & _flag(pc.equal(kind, "CONN"))
-        other = ~conn & has_kind & _is_number(_field(fields, 0, has_kind))
+        # a line shaped like a connection (5 fields ending up|down) with another kind is a typo, not a message
+        state_like = (n == 5) & _flag(pc.is_in(_field(fields, 4, n == 5), pa.array(["up", "down"])))
+        other = ~conn & ~state_like & has_kind & _is_number(_field(fields, 0, has_kind))
         rows.counts["other_events"] += int(other.sum())
-        ok = _field_count_ok(np.where(other, 5, n), (5,), line, rows, "time CONN a b up|down") & ~other
+        ok = _field_count_ok(np.where(other, 5, n), (5,), fields, line, rows, "time CONN a b up|down") & ~other
+        ok &= rows.reject(ok & ~conn, line, "kind", kind, "event kind must be CONN for a connection up|down")
         t_col, a, b, state = (_field(fields, k, ok) for k in (0, 2, 3, 4))
         t, t_ok = _times(t_col, line, "time", rows, minimum=0.0, active=ok)
         ok &= t_ok
@@ -211,17 +218,23 @@ def _connection_starts(t, lo, hi, up) -> tuple[np.ndarray, dict[str, int]]:
     """Mask of ``up`` lines that open a connection, and the tallies of the odd lines.
 
     Per pair, lines in time order (ties in file order): an ``up`` opens iff the pair's
-    previous line is not an ``up``; a ``down`` closes iff it is.
+    previous line is not an ``up``; a ``down`` closes iff it is.  An ``up`` that reopens
+    a connection at the very time it opened (up, down, up at one t) continues that
+    encounter: one event per pair and time.
     """
     order = np.lexsort((np.arange(len(t)), t, hi, lo))
-    los, his, ups = lo[order], hi[order], up[order]
+    ts, los, his, ups = t[order], lo[order], hi[order], up[order]
     same_pair = np.r_[False, (los[1:] == los[:-1]) & (his[1:] == his[:-1])]
     prev_up = same_pair & np.r_[False, ups[:-1]]
     last_of_pair = ~np.r_[same_pair[1:], False]
     opens = ups & ~prev_up
+    k = np.flatnonzero(opens)  # the opening lines, in (pair, time) order
+    at_once = np.r_[False, (los[k[1:]] == los[k[:-1]]) & (his[k[1:]] == his[k[:-1]]) & (ts[k[1:]] == ts[k[:-1]])]
+    opens[k[at_once]] = False
     start = np.empty(len(t), bool)
     start[order] = opens
     return start, {"repeated_up": int((ups & prev_up).sum()),
+                   "reopened_at_once": int(at_once.sum()),
                    "unmatched_down": int((~ups & ~prev_up).sum()),
                    "open_at_end": int((ups & last_of_pair).sum())}
 
@@ -274,13 +287,7 @@ def _build(t, a, b, line, rows: "_Rows", fmt: str, meta_extra: dict) -> Encounte
         except pa.ArrowInvalid:  # beyond int64: keep text
             pass
     meta = {"units": {"time": "s"}, "ingest": {**rows.report(fmt).as_meta(), **meta_extra}}
-    try:
-        return EncounterLog.from_records(t, a, b, meta=meta, source={"events": rows.file})
-    except InputError as exc:
-        if exc.row is None or exc.file != rows.file:
-            raise
-        raise InputError(exc.reason, file=rows.file, row=int(line[exc.row - 1]), column=exc.column,
-                         value=exc.value) from None
+    return EncounterLog.from_records(t, a, b, meta=meta, source={"events": rows.file}, event_rows=line)
 
 
 # -- line bookkeeping -------------------------------------------------------------------------
@@ -296,6 +303,7 @@ class _Rows:
         self._line: list[np.ndarray] = []
         self._cols: dict[str, list] = {}
         self._pending: list[tuple] = []  # first bad line per check of the current block
+        self.time_type: str | None = None  # a Parquet time column's date/time type, read as seconds
 
     def reject(self, bad: np.ndarray, line: np.ndarray, column: str, values: pa.Array, reason: str) -> np.ndarray:
         """Deal with the lines of mask ``bad``; returns ``~bad`` (the lines still usable).
@@ -367,6 +375,8 @@ def _concat(parts) -> pa.Array:
 # -- reading blocks -----------------------------------------------------------------------------
 def _existing(path) -> Path:
     path = Path(path)
+    if path.is_dir():
+        raise InputError("is a folder, not a trace file", file=str(path))
     if not path.is_file():
         raise InputError("trace file not found", file=str(path))
     return path
@@ -379,12 +389,7 @@ def _csv_batches(path: Path, names: dict[str, str], rows: _Rows):
     the handler in order with their line numbers; blank lines arrive as empty rows.
     """
     header = _csv_header(path)
-    raw = {name.strip(): name for name in header}
-    missing = [c for c in names.values() if c not in raw]
-    if missing:
-        raise InputError(f"missing column {missing[0]!r}; found columns: {', '.join(map(repr, raw))}",
-                         file=str(path), column=missing[0])
-    names = {key: raw[col] for key, col in names.items()}
+    names = {key: _column_of(header, col, path) for key, col in names.items()}
     bad_rows: list[int] = []  # data rows the parser could not split, all so far
 
     def invalid(row) -> str:
@@ -420,6 +425,17 @@ def _csv_batches(path: Path, names: dict[str, str], rows: _Rows):
         raise InputError(f"cannot parse CSV ({exc})", file=str(path)) from None
 
 
+def _column_of(header: list[str], name: str, path: Path) -> str:
+    """The header's column called ``name`` (blanks round a header name ignored); a name
+    missing or found twice is refused."""
+    found = [h for h in header if h.strip() == name]
+    if len(found) != 1:
+        problem = "missing column" if not found else "column appears twice:"
+        raise InputError(f"{problem} {name!r}; found columns: {', '.join(map(repr, header))}",
+                         file=str(path), column=name)
+    return found[0]
+
+
 def _csv_header(path: Path) -> list[str]:
     try:
         with pcsv.open_csv(path, read_options=pcsv.ReadOptions(block_size=1 << 16),
@@ -435,27 +451,44 @@ def _parquet_batches(path: Path, names: dict[str, str], rows: _Rows):
         pf = pq.ParquetFile(path)
     except (pa.ArrowException, OSError) as exc:
         raise InputError(f"cannot read Parquet file ({exc})", file=str(path)) from None
-    missing = [c for c in names.values() if c not in pf.schema_arrow.names]
-    if missing:
-        raise InputError(f"missing column {missing[0]!r}; found columns: "
-                         f"{', '.join(map(repr, pf.schema_arrow.names))}", file=str(path), column=missing[0])
+    schema = pf.schema_arrow
+    names = {key: _column_of(schema.names, col, path) for key, col in names.items()}
+    indices = {key: schema.names.index(col) for key, col in names.items()}
     start = 0
     for batch in pf.iter_batches(batch_size=1 << 18, columns=list(dict.fromkeys(names.values()))):
         cols = {}
         for key, col in names.items():
-            arr = batch.column(col)
+            arr = batch.column(batch.schema.names.index(col))
             if pa.types.is_dictionary(arr.type):
                 arr = arr.dictionary_decode()
+            if key == "t" and pa.types.is_temporal(arr.type):
+                rows.time_type = f"{arr.type}, read as seconds" + (" since 1970-01-01" if not (
+                    pa.types.is_duration(arr.type) or pa.types.is_time(arr.type)) else "")
+                arr = _seconds(arr)
+            elif key != "t" and pa.types.is_floating(arr.type):
+                arr = pc.if_else(pc.is_nan(arr), pa.scalar(None, arr.type), arr)  # NaN: no ID
             if key != "t" or not (pa.types.is_integer(arr.type) or pa.types.is_floating(arr.type)):
                 try:
-                    arr = _trim(pc.cast(arr, pa.string()))
+                    arr = pc.cast(arr, pa.string())  # Parquet values are exact: not trimmed
                 except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
                     raise InputError(f"column of type {arr.type} cannot hold {'times' if key == 't' else 'agent IDs'}",
-                                     file=str(path), column=col) from None
+                                     file=str(path), column=schema.names[indices[key]]) from None
             cols[key] = arr
         rows.lines += batch.num_rows
         yield np.arange(start + 1, start + batch.num_rows + 1), cols
         start += batch.num_rows
+
+
+_SECONDS_PER_UNIT = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+
+
+def _seconds(arr: pa.Array) -> pa.Array:
+    """A date, time, timestamp or duration column as float64 seconds (dates and
+    timestamps since 1970-01-01, times of day since midnight); nulls stay null."""
+    if pa.types.is_date32(arr.type):
+        return pc.multiply(pc.cast(arr.view(pa.int32()), pa.float64()), 86400.0)
+    unit = "ms" if pa.types.is_date64(arr.type) else arr.type.unit
+    return pc.multiply(pc.cast(pc.cast(arr, pa.int64()), pa.float64(), safe=False), _SECONDS_PER_UNIT[unit])
 
 
 def _text_batches(path: Path, rows: _Rows):
@@ -465,18 +498,21 @@ def _text_batches(path: Path, rows: _Rows):
     blank lines are counted and dropped here.
     """
     line_no = 0
-    with open(path, "rb") as f:
-        tail = b""
+    with _open_text(path) as f:
+        tail = f.read(3)
+        tail = tail[3:] if tail == b"\xef\xbb\xbf" else tail  # a UTF-8 byte order mark
         while True:
             block = f.read(_BLOCK)
             data = tail + block
             if block:
-                cut = data.rfind(b"\n") + 1
+                # cut after the last line end; a final \r waits: a \n may follow in the next block
+                cut = max(data.rfind(b"\n"), data.rfind(b"\r", 0, len(data) - 1)) + 1
                 data, tail = data[:cut], data[cut:]
                 if not data:
                     continue
             elif not data:
                 return
+            data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")  # CRLF and CR-only line ends
             lines = pc.split_pattern(pa.array([data], pa.large_binary()), b"\n").flatten()
             if block or data.endswith(b"\n"):
                 lines = lines.slice(0, len(lines) - 1)  # after the final newline: nothing
@@ -494,6 +530,13 @@ def _text_batches(path: Path, rows: _Rows):
                 return
 
 
+def _open_text(path: Path):
+    """The file's bytes, gunzipped if it is gzip (by its magic number, not its name)."""
+    with open(path, "rb") as f:
+        gzipped = f.read(2) == b"\x1f\x8b"
+    return gzip.open(path, "rb") if gzipped else open(path, "rb")
+
+
 def _utf8_lines(lines: pa.Array, numbers: np.ndarray, rows: _Rows):
     """Lines as text; a line that is not UTF-8 is malformed."""
     bad = _not_utf8(lines)
@@ -503,17 +546,21 @@ def _utf8_lines(lines: pa.Array, numbers: np.ndarray, rows: _Rows):
 
 
 def _not_utf8(col: pa.Array) -> np.ndarray:
-    """Mask of the binary values that are not UTF-8: one cast if all are, else bisection
-    per bad value (O(log n) casts each)."""
-    bad = np.zeros(len(col), bool)
-    while True:
-        idx = np.flatnonzero(~bad)
-        rest = col.take(pa.array(idx))
-        try:
-            pc.cast(rest, pa.large_string())
-            return bad
-        except pa.ArrowInvalid:
-            bad[idx[_first_uncastable(rest, pa.large_string())]] = True
+    """Mask of the binary values that are not UTF-8: one cast if all are, else each
+    value of the block decoded once (a file saved in Latin-1 costs O(n), not O(n^2))."""
+    try:
+        pc.cast(col, pa.large_string())
+        return np.zeros(len(col), bool)
+    except pa.ArrowInvalid:
+        return np.fromiter((v is not None and not _decodes(v) for v in col.to_pylist()), bool, count=len(col))
+
+
+def _decodes(value: bytes) -> bool:
+    try:
+        value.decode("utf-8")
+        return True
+    except UnicodeDecodeError:
+        return False
 
 
 # -- vectorised checks ------------------------------------------------------------------------
@@ -548,26 +595,32 @@ def _is_number(col: pa.Array) -> np.ndarray:
     return pc.fill_null(pc.match_substring_regex(col, _NUMBER), False).to_numpy(zero_copy_only=False)
 
 
-def _field_count_ok(n: np.ndarray, allowed: tuple[int, ...], line, rows: _Rows, layout: str) -> np.ndarray:
-    return rows.reject(~np.isin(n, allowed), line, "fields", pa.array(n),
-                       f"expected {' or '.join(map(str, allowed))} fields: {layout}")
+def _field_count_ok(n: np.ndarray, allowed: tuple[int, ...], fields: pa.Array, line, rows: _Rows,
+                    layout: str) -> np.ndarray:
+    """Lines with an allowed number of fields; the others are refused, quoting the line."""
+    bad = ~np.isin(n, allowed)
+    text = pc.binary_join(fields, " ") if bad.any() else fields
+    return rows.reject(bad, line, None, text, f"expected {' or '.join(map(str, allowed))} fields: {layout}")
 
 
 def _times(col: pa.Array, line, name: str, rows: _Rows, *, minimum: float, active=None,
            below: str | None = None) -> tuple[np.ndarray, np.ndarray]:
     """float64 times and the mask of usable lines; bad times are rejected."""
     active = np.ones(len(col), bool) if active is None else active
+    ok = rows.reject(active & col.is_null().to_numpy(zero_copy_only=False), line, name, col, "time is missing")
     if pa.types.is_integer(col.type) or pa.types.is_floating(col.type):
-        t = pc.cast(col, pa.float64()).fill_null(np.nan).to_numpy(zero_copy_only=False)
-        ok = rows.reject(active & ~np.isfinite(t), line, name, col, "time must be a finite number")
+        # unsafe: integers beyond 2^53 round, and are refused below as too late
+        t = pc.cast(col, pa.float64(), safe=False).fill_null(0.0).to_numpy(zero_copy_only=False)
+        ok &= rows.reject(active & ok & ~np.isfinite(t), line, name, col, "time must be a finite number")
     else:
-        ok = rows.reject(active & ~_is_number(col), line, name, col, "time is not a number")
+        ok &= rows.reject(active & ok & ~_is_number(col), line, name, col, "time is not a number")
         parsed = pc.cast(pc.if_else(pa.array(active & ok), col, "0"), pa.float64())
         t = parsed.to_numpy(zero_copy_only=False)
         ok &= rows.reject(active & ok & ~np.isfinite(t), line, name, col, "time must be a finite number")
     reason = below or ("time must not be negative" if minimum == 0 else f"time must be >= {minimum:g}")
     ok &= rows.reject(active & ok & ~(t >= minimum), line, name, col, reason)
-    return t, ok & active
+    ok &= rows.reject(active & ok & (t >= MAX_TIME), line, name, col, TOO_LATE)
+    return t + 0.0, ok & active  # + 0.0: -0.0 -> 0.0
 
 
 def _ids_ok(a: pa.Array, b: pa.Array, line, names: tuple[str, str], rows: _Rows, active=None) -> np.ndarray:

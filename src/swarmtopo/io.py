@@ -71,7 +71,7 @@ GROUND_TRUTH_FILES = ("arena.geojson", *(f"{stem}.{fmt}" for stem in ("truth", "
 _TABLE_STEMS = ("events", "status", "truth", "trajectories")
 _OTHER_ENCODINGS = ((b"\xff\xfe\x00\x00", "UTF-32"), (b"\x00\x00\xfe\xff", "UTF-32"),
                     (b"\xff\xfe", "UTF-16"), (b"\xfe\xff", "UTF-16"))
-_PLAIN_INTEGER = r"^-?(0|[1-9][0-9]*)$"
+_PLAIN_INTEGER = r"^(0|-?[1-9][0-9]*)$"  # not 017, not -0: those stay text
 
 
 # -- log folders -------------------------------------------------------------------------
@@ -83,6 +83,7 @@ def write_log(
     truth: dict | None = None,
     trajectories: dict | None = None,
     arena: Arena | None = None,
+    protect=(),
 ) -> list[Path]:
     """Write a log folder (see the module docstring); returns the paths written.
 
@@ -112,11 +113,19 @@ def write_log(
         (strings or codes into STATES) and extra columns.
     arena
         The true arena, written as ``arena.geojson``.
+    protect
+        Files that must survive (the trace an ingest reads): if one of them is a
+        contract file of the folder, nothing is written and InputError says so.
     """
     if fmt not in FORMATS:
         raise SwarmtopoError(f"unknown log format {fmt!r}; expected one of {', '.join(FORMATS)}")
     directory = Path(directory)
-    _make_folder(directory)
+    protected = {Path(p).resolve() for p in protect}
+    for path in log_files(directory):
+        if path.resolve() in protected:
+            raise InputError("the log folder would overwrite or delete this file; write the log to another "
+                             "folder", file=str(path))
+    make_folder(directory)
     ids_a, ids_b = log.ids_of(log.a), log.ids_of(log.b)
     tables = {"events": {"t": log.t, "a": ids_a, "b": ids_b}}
     if len(log.status_t):
@@ -136,15 +145,21 @@ def write_log(
     if arena is not None:
         written.append(write_arena(arena, directory / "arena.geojson"))
     keep = {p.name for p in written}
-    stale = [f"{stem}.{f}" for stem in _TABLE_STEMS for f in FORMATS] + ["meta.json", "arena.geojson"]
-    for name in stale:
-        if name not in keep and (directory / name).is_file():
+    for path in log_files(directory):
+        if path.name not in keep:
             try:
-                (directory / name).unlink()
+                path.unlink()
             except OSError as exc:
-                raise InputError(f"cannot delete an outdated log file ({_os_reason(exc)})",
-                                 file=str(directory / name)) from None
+                raise InputError(f"cannot delete an outdated log file ({_os_reason(exc)})", file=str(path)) from None
     return written
+
+
+def log_files(directory) -> list[Path]:
+    """The contract files (``events.*``, ``status.*``, ``truth.*``, ``trajectories.*``,
+    ``meta.json``, ``arena.geojson``) present in ``directory``: what :func:`write_log`
+    writes there or deletes as outdated."""
+    names = [f"{stem}.{f}" for stem in _TABLE_STEMS for f in FORMATS] + ["meta.json", "arena.geojson"]
+    return [Path(directory) / name for name in names if (Path(directory) / name).is_file()]
 
 
 def read_log(directory) -> EncounterLog:
@@ -184,10 +199,15 @@ def read_log(directory) -> EncounterLog:
     static_cols = None
     if static is not None:
         static_cols = ([entry["agent"] for entry in static], [entry["time"] for entry in static])
-    return EncounterLog.from_records(
+    log = EncounterLog.from_records(
         t, ids[0], ids[1], status=status_cols, static=static_cols, meta=meta,
         source={"events": str(events_path), "status": str(status_path), "static": f"{meta_path} static"},
     )
+    last = max([float(x.max()) for x in (log.t, log.status_t) if len(x)], default=0.0)
+    if "duration" in meta and meta["duration"] < last:
+        raise InputError(f"key 'duration' is {meta['duration']:g} s but the log runs to t = {last:g} s",
+                         file=str(meta_path), column="duration", value=meta["duration"])
+    return log
 
 
 def read_truth(directory) -> dict[str, np.ndarray] | None:
@@ -253,7 +273,7 @@ def strip_ground_truth(src_dir, dst_dir) -> None:
     src, dst = _log_dir(src_dir), Path(dst_dir)
     if dst.exists() and (not dst.is_dir() or any(dst.iterdir())):
         raise InputError("destination must be a new or empty folder", file=str(dst))
-    _make_folder(dst)
+    make_folder(dst)
     for stem in ("events", "status"):
         path = _find_table(src, stem, required=stem == "events")
         if path is not None:
@@ -399,7 +419,8 @@ def _arrow_column(values) -> pa.Array:
     return pa.array(arr)
 
 
-def _make_folder(directory: Path) -> None:
+def make_folder(directory: Path) -> None:
+    """Create ``directory`` (and its parents); InputError naming it if that fails."""
     try:
         directory.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -443,14 +464,23 @@ def _builtin(obj):
 
 
 # -- reading helpers -----------------------------------------------------------------------
+def _not_a_folder(path: Path) -> None:
+    """A log file that is a folder is refused, not skipped as absent."""
+    if path.is_dir():
+        raise InputError("is a folder, not a log file", file=str(path))
+
+
 def _log_dir(directory) -> Path:
     directory = Path(directory)
     if not directory.is_dir():
-        raise InputError("log folder not found", file=str(directory))
+        raise InputError("is a file, not a log folder" if directory.exists() else "log folder not found",
+                         file=str(directory))
     return directory
 
 
 def _find_table(directory: Path, stem: str, *, required: bool = False) -> Path | None:
+    for fmt in FORMATS:
+        _not_a_folder(directory / f"{stem}.{fmt}")
     found = [directory / f"{stem}.{fmt}" for fmt in FORMATS if (directory / f"{stem}.{fmt}").is_file()]
     if len(found) > 1:
         raise InputError(f"both {found[0].name} and {found[1].name} exist; keep one", file=str(directory))
@@ -588,7 +618,7 @@ def _number_column(col: pa.Array, path: Path, name: str, what: str) -> np.ndarra
             problem = f"{what} is missing" if value == "" else f"{what} is not a number"
             raise InputError(problem, file=str(path), row=i + 1, column=name, value=value) from None
     elif pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_decimal(kind):
-        col = pc.cast(col, pa.float64())
+        col = pc.cast(col, pa.float64(), safe=False)  # integers beyond 2^53 round; times that large are refused
     elif pa.types.is_null(kind) and len(col) == 0:
         col = pa.array([], pa.float64())
     else:
@@ -658,8 +688,14 @@ def _extra_columns(table: dict[str, pa.Array], known: dict) -> dict[str, np.ndar
     return {name: col.to_numpy(zero_copy_only=False) for name, col in table.items() if name not in known}
 
 
+NUMBER_META_KEYS = {"r_d": "detection radius, mm", "v_c": "random-walk speed, mm/s",
+                    "v_p": "wall-following speed, mm/s", "dt": "time step, s", "duration": "seconds recorded"}
+"""Keys of meta.json that, when present, must be finite numbers, positive (duration: >= 0)."""
+
+
 def _read_meta(path: Path) -> dict:
     """meta.json as a dict ({} if absent), with ``static`` and the ID keys checked."""
+    _not_a_folder(path)
     if not path.is_file():
         return {}
     meta = read_json(path)
@@ -674,9 +710,20 @@ def _read_meta(path: Path) -> dict:
             if not (isinstance(entry, dict) and "agent" in entry and "time" in entry):
                 raise InputError(f"key 'static': entry {i + 1} must be an object with 'agent' and 'time'",
                                  file=str(path), value=entry)
+    units = meta.get("units")
+    if isinstance(units, dict) and units.get("time", "s") != "s":
+        raise InputError("key 'units.time' must be \"s\": swarmtopo reads times in seconds", file=str(path),
+                         column="units.time", value=units["time"])
     if "format" in meta and meta["format"] != LOG_FORMAT:
         raise InputError(f"key 'format' is not {LOG_FORMAT!r}, the only log format this swarmtopo reads",
-                         file=str(path), value=meta["format"])
+                         file=str(path), column="format",
+                         value=meta["format"] if isinstance(meta["format"], str) else json.dumps(meta["format"]))
+    for key, what in NUMBER_META_KEYS.items():
+        value = meta.get(key)
+        if key in meta and (isinstance(value, bool) or not isinstance(value, (int, float))
+                            or not math.isfinite(value) or value < 0 or (value == 0 and key != "duration")):
+            raise InputError(f"key '{key}' must be a {'non-negative' if key == 'duration' else 'positive'} number "
+                             f"({what})", file=str(path), column=key, value=value)
     count = meta.get("agent_count")
     if count is not None and (isinstance(count, bool) or not isinstance(count, int) or count < 0):
         raise InputError("key 'agent_count' must be a non-negative integer", file=str(path), value=count)
@@ -688,6 +735,10 @@ def _read_meta(path: Path) -> dict:
             if isinstance(v, bool) or not isinstance(v, (int, str)) or (isinstance(v, str) and not v.strip()):
                 raise InputError(f"key 'agent_ids': entry {i + 1} must be an integer or a non-empty text",
                                  file=str(path), value=v)
+        if len(set(map(str, ids))) != len(ids):
+            seen: set = set()
+            twice = next(v for v in ids if str(v) in seen or seen.add(str(v)))
+            raise InputError("key 'agent_ids' lists an agent twice", file=str(path), column="agent_ids", value=twice)
         if count is not None and count != len(ids):
             raise InputError(f"key 'agent_count' is {count} but 'agent_ids' lists {len(ids)} agents",
                              file=str(path), value=count)

@@ -29,6 +29,10 @@ STATES: tuple[str, ...] = ("RW", "WF", "S")
 """Status codes: index in this tuple.  RW random walk, WF wall following, S stopped."""
 RW, WF, S = 0, 1, 2
 _STATE_LABELS = np.asarray(STATES, dtype=object)
+MAX_TIME = 2.0 ** 53
+"""Times (s) must be below 2^53, where float64 still tells whole seconds apart; a larger
+time is in another unit (nanoseconds since 1970 are about 1.4e18)."""
+TOO_LATE = "time is 2^53 s or more: times must be in seconds (divide nanoseconds by 1e9)"
 
 
 @dataclass(frozen=True, eq=False)
@@ -76,6 +80,7 @@ class EncounterLog:
         static: tuple | None = None,
         meta: dict | None = None,
         source: dict[str, str] | None = None,
+        event_rows=None,
     ) -> "EncounterLog":
         """Validate raw columns and build a canonical log.
 
@@ -94,20 +99,33 @@ class EncounterLog:
             are then the integers ``0 .. agent_count-1``), every ID must be in it.
         source
             Names used in error messages: keys ``events``, ``status``, ``static``.
+        event_rows
+            The source row of each event (1-based), quoted in error messages instead
+            of its position (a reader that dropped blank or skipped lines knows them).
 
         Raises
         ------
         InputError
             Quoting the source, 1-based row, column and value: non-numeric, NaN or
-            negative times, a == b, unknown states, undeclared IDs, duplicate events,
+            negative times, times of 2^53 s or more, a == b, unknown states, undeclared IDs, duplicate events,
             two status rows for one agent at one time (conflicting or repeated).
             Unsorted input is sorted, not rejected.
         """
         source = {"events": "events", "status": "status", "static": "meta.json static", **(source or {})}
         meta = dict(meta or {})
         src_e = source["events"]
-        t = _times(t, src_e, "t")
-        ev_a, ev_b = _factorize_ids(a, src_e, "a"), _factorize_ids(b, src_e, "b")
+
+        def row(i) -> int:
+            return int(event_rows[i]) if event_rows is not None else int(i) + 1
+
+        try:
+            t = _times(t, src_e, "t")
+            ev_a, ev_b = _factorize_ids(a, src_e, "a"), _factorize_ids(b, src_e, "b")
+        except InputError as exc:
+            if event_rows is None or exc.row is None:
+                raise
+            raise InputError(exc.reason, file=exc.file, row=row(exc.row - 1), column=exc.column,
+                             value=exc.value) from None
         if not (len(t) == len(ev_a.index) == len(ev_b.index)):
             raise InputError("columns t, a, b have different lengths", file=src_e)
         if status is not None:
@@ -136,7 +154,8 @@ class EncounterLog:
                 if bad.any():
                     i = int(np.argmax(bad))
                     raise InputError("agent ID is not among the agents the metadata declares",
-                                     file=col.src, row=i + 1, column=col.column, value=col.value(i))
+                                     file=col.src, row=row(i) if col.src == src_e else i + 1,
+                                     column=col.column, value=col.value(i))
             agent_ids = np.unique(declared)
         else:
             agent_ids = np.unique(np.concatenate([c.labels for c in id_cols]))
@@ -147,7 +166,7 @@ class EncounterLog:
         self_pair = ca == cb
         if self_pair.any():
             i = int(np.argmax(self_pair))
-            raise InputError("an agent cannot encounter itself (a == b)", file=src_e, row=i + 1,
+            raise InputError("an agent cannot encounter itself (a == b)", file=src_e, row=row(i),
                              column="b", value=id_cols[1].value(i))
         lo, hi = np.minimum(ca, cb), np.maximum(ca, cb)
         pair = lo * max(len(agent_ids), 1) + hi  # orders like (lo, hi)
@@ -161,9 +180,9 @@ class EncounterLog:
         dup = (dt == 0) & (dpair == 0)
         if dup.any():
             k = int(np.argmax(dup))
-            r1, r2 = sorted((int(order[k]) + 1, int(order[k + 1]) + 1))
+            r1, r2 = sorted((row(order[k]), row(order[k + 1])))
             raise InputError(f"duplicate event: same time and pair as row {r1}", file=src_e, row=r2,
-                             value=f"{t[k]:g}, {agent_ids[lo[k]]}, {agent_ids[hi[k]]}")
+                             value=f"{exact_time(t[k])}, {agent_ids[lo[k]]}, {agent_ids[hi[k]]}")
 
         st_order = np.lexsort((st_t, cst))
         _refuse_repeated_status(st_t, cst, st_state, st_order, agent_ids, source["status"])
@@ -261,7 +280,16 @@ def _times(values, src, col) -> np.ndarray:
     if neg.any():
         i = int(np.argmax(neg))
         raise InputError("time must not be negative", file=src, row=i + 1, column=col, value=arr[i])
-    return out
+    huge = out >= MAX_TIME
+    if huge.any():
+        i = int(np.argmax(huge))
+        raise InputError(TOO_LATE, file=src, row=i + 1, column=col, value=arr[i])
+    return out + 0.0  # -0.0 -> 0.0
+
+
+def exact_time(t: float) -> str:
+    """A time as its shortest exact decimal (no exponent, no rounding): 1400028780, 0.5."""
+    return np.format_float_positional(float(t), trim="-")
 
 
 @dataclass(frozen=True)

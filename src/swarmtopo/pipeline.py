@@ -34,12 +34,17 @@ from .errors import SwarmtopoError
 from .graph import METRICS, EncounterGraph, agent_gaps, build_graph
 from .io import jsonable
 from .landmarks import SUBSAMPLERS, Landmarks, knn_distances, knn_maxmin, maxmin, probabilistic_maxmin
-from .log import EncounterLog
+from .log import EncounterLog, exact_time
 from .persistence import Diagram, PersistenceResult, rips_persistence
 from .ratio import longest_bars, vote
 
 
 MIN_REGION_AGENTS = 3
+MAX_HOP_COST, MAX_WALL_FOLLOW_WEIGHT = 1e9, 1e6
+"""Bounds of the per-hop cost (s, about 30 years) and of the wall-following charge (s/s):
+far beyond any log, and far below where squared distances overflow in MDS."""
+MAX_WINDOWS_LISTED = 100_000
+"""Most windows of one length a log may be cut into before the cap picks its share."""
 """Distinct agents a component needs to count as a region (two agents alone that keep
 meeting say nothing about the arena)."""
 AUTO_COVER_FACTOR = 1.5
@@ -223,14 +228,15 @@ class MapConfig:
             raise SwarmtopoError(f"landmarks must be at least 3, got {self.landmarks}")
         if self.max_landmarks < 3:
             raise SwarmtopoError(f"max_landmarks must be at least 3, got {self.max_landmarks}")
-        if self.hop_cost is not None and not (np.isfinite(self.hop_cost) and self.hop_cost >= 0):
-            raise SwarmtopoError(f"hop_cost must be a number of seconds >= 0, got {self.hop_cost}")
+        if self.hop_cost is not None and not (np.isfinite(self.hop_cost) and 0 <= self.hop_cost <= MAX_HOP_COST):
+            raise SwarmtopoError(f"hop_cost must be a number of seconds in [0, {MAX_HOP_COST:g}], got {self.hop_cost}")
         if self.diffusion_time is not None and not self.diffusion_time > 0:
             raise SwarmtopoError(f"diffusion_time must be a positive number of seconds or inf, got "
                                  f"{self.diffusion_time}")
         if self.wall_follow_weight is not None and not (np.isfinite(self.wall_follow_weight)
-                                                        and self.wall_follow_weight >= 0):
-            raise SwarmtopoError(f"wall_follow_weight must be a number >= 0 or None, got {self.wall_follow_weight}")
+                                                        and 0 <= self.wall_follow_weight <= MAX_WALL_FOLLOW_WEIGHT):
+            raise SwarmtopoError(f"wall_follow_weight must be a number in [0, {MAX_WALL_FOLLOW_WEIGHT:g}] or None, "
+                                 f"got {self.wall_follow_weight}")
         if self.window_length is not None and not self.window_length > 0:
             raise SwarmtopoError(f"window_length must be a positive number of seconds, got {self.window_length}")
         if not (np.isfinite(self.window_encounters) and self.window_encounters > 0):
@@ -442,8 +448,8 @@ def map_encounters(
             f"the log has {log.n_events} event(s); at least 2 encounters are needed to build a map")
     say("graph")
     t0 = time.perf_counter()
-    hop_cost, hop_source = resolve_hop_cost(log, config.hop_cost)
     mapped = log if config.window is None else log.window(*config.window)
+    hop_cost, hop_source = resolve_hop_cost(mapped, config.hop_cost)
     agent_gap = mean_agent_gap(mapped)
     diffusion_time, diffusion_source = resolve_diffusion_time(agent_gap, config.diffusion_time)
     graph = build_graph(log, config.metric, window=config.window, hop_cost=hop_cost, diffusion_time=diffusion_time,
@@ -454,13 +460,19 @@ def map_encounters(
     agents_per_comp = _agents_per_component(log, graph.event_index, event_comp, n_comp)
     timings["graph"] = time.perf_counter() - t0
 
-    is_region = (events_per_comp >= config.min_region_events) & (agents_per_comp >= MIN_REGION_AGENTS)
+    if graph.event_t.min() == graph.event_t.max():
+        raise SwarmtopoError(f"all {graph.n_events} encounters are at one time (t = {exact_time(graph.event_t[0])} s); "
+                             f"a map needs encounters spread over time")
+    is_region = ((events_per_comp >= config.min_region_events) & (agents_per_comp >= MIN_REGION_AGENTS)
+                 & (np.bincount(labels, minlength=n_comp) >= 2))  # one node: its encounters all at one instant
     regions_idx = [int(c) for c in np.argsort(-events_per_comp, kind="stable") if is_region[c]]
     if not regions_idx:
+        largest = int(np.argmax(events_per_comp))
         raise SwarmtopoError(
             f"no connected group of encounters has {config.min_region_events} events or more among "
-            f"{MIN_REGION_AGENTS} agents or more (largest: {int(events_per_comp.max())} of {graph.n_events} "
-            f"events in {n_comp} groups); the log is too short or the agents too few to map: collect more data")
+            f"{MIN_REGION_AGENTS} agents or more (largest: {int(events_per_comp[largest])} events among "
+            f"{int(agents_per_comp[largest])} agents, of {graph.n_events} events in {n_comp} groups); "
+            f"the log is too short or the agents too few to map: collect more data")
 
     shares = (_share_landmarks(config.landmarks, events_per_comp[regions_idx]) if config.landmarks
               else [None] * len(regions_idx))
@@ -469,12 +481,12 @@ def map_encounters(
     spans, left_out = _scaled_windows(graph.event_t, [
         resolve_window(agent_gap, None if config.window_length is None else scale * config.window_length,
                        scale * config.window_encounters, log_span)[0] for scale in config.window_scales],
-        config.window_step, config.max_windows)
+        config.window_step, config.max_windows, config.min_region_events)
     window_graphs = []  # (span, graph, component labels) of each window
     for span in spans:
         if span is None:  # the whole log: a scale whose windows would not be shorter than it
             window_graphs.append((None, graph, labels))
-        elif _events_within(log, span) >= config.min_region_events:  # a gap in a real trace is skipped
+        else:
             wgraph = build_graph(log, config.metric, window=span, hop_cost=hop_cost,
                                  diffusion_time=diffusion_time, wall_follow_weight=config.wall_follow_weight)
             window_graphs.append((span, wgraph, wgraph.components()[1]))
@@ -486,9 +498,12 @@ def map_encounters(
             part = _region_part(wgraph, wlabels, region_events, log, config)
             if part is not None:
                 windows.append(_map_window(span, part, n_land, config, rng, timings, say))
+        fallback = []
         if not windows:  # no window holds enough of this region: map its whole log instead
             whole = graph.subgraph(np.flatnonzero(labels == comp))
             windows = [_map_window(None, whole, n_land, config, rng, timings, say)]
+            fallback = [f"no window ({window_length:.3g} s long) holds {config.min_region_events} encounters of "
+                        f"this region among {MIN_REGION_AGENTS} agents: its whole log was mapped instead"]
         say("classify")
         t0 = time.perf_counter()
         diagrams = [w.diagram for w in windows]
@@ -519,7 +534,7 @@ def map_encounters(
             betti=betti_region,
             confidence=confidence_region,
             cycles=[],
-            warnings=_sampling_warnings(chosen.scales, len(chosen.landmarks.nodes), config),
+            warnings=fallback + _sampling_warnings(chosen.scales, len(chosen.landmarks.nodes), config),
             embedding=emb,
             windows=windows,
             window=rep,
@@ -652,13 +667,17 @@ def _windows(event_t: np.ndarray, length: float, step: float | None = None) -> l
         return [None]
     step = length / 2 if step is None else step
     n = 1 + int(np.ceil((t_last - t_first - length) / step - 1e-9))
+    if n > MAX_WINDOWS_LISTED:
+        raise SwarmtopoError(f"windows of {length:.3g} s every {step:.3g} s over the log's {t_last - t_first:.6g} s "
+                             f"would be {n:,}, more than {MAX_WINDOWS_LISTED:,}: use longer windows")
     return [(float(s), float(s) + length) for s in np.linspace(t_first, t_last - length, n)]
 
 
-def _scaled_windows(event_t: np.ndarray, lengths, step: float | None = None,
-                    cap: int | None = None) -> tuple[list[tuple[float, float] | None], int]:
-    """The distinct windows of every length in ``lengths`` (:func:`_windows`), in order:
-    by length as given, then by start; and how many the cap left out.
+def _scaled_windows(event_t: np.ndarray, lengths, step: float | None = None, cap: int | None = None,
+                    min_events: int = 0) -> tuple[list[tuple[float, float] | None], int]:
+    """The distinct windows of every length in ``lengths`` (:func:`_windows`) that hold at
+    least ``min_events`` events (a gap in a real trace is skipped), in order: by length as
+    given, then by start; and how many the cap left out.
 
     With more than ``cap`` distinct windows, each length keeps a share of its windows
     in proportion to their number, at least one (largest remainders, so the shares sum
@@ -666,8 +685,14 @@ def _scaled_windows(event_t: np.ndarray, lengths, step: float | None = None,
     from its first window to its last (one window: the middle one)."""
     seen: set = set()
     per_length = []
+    times = np.sort(event_t)
+
+    def enough(span) -> bool:
+        return span is None or (np.searchsorted(times, span[1], side="right")
+                                - np.searchsorted(times, span[0], side="left")) >= min_events
+
     for length in lengths:
-        spans = [span for span in _windows(event_t, length, step) if span not in seen]
+        spans = [span for span in _windows(event_t, length, step) if span not in seen and enough(span)]
         seen.update(spans)
         per_length.append(spans)
     sizes = np.array([len(spans) for spans in per_length])
@@ -702,10 +727,6 @@ def _evenly(n: int, k: int) -> np.ndarray:
     return np.unique(np.linspace(0, n - 1, k).round().astype(int))
 
 
-def _events_within(log: EncounterLog, span: tuple[float, float]) -> int:
-    return int(np.searchsorted(log.t, span[1], side="right") - np.searchsorted(log.t, span[0], side="left"))
-
-
 def _region_part(graph: EncounterGraph, labels: np.ndarray, region_events: np.ndarray, log: EncounterLog,
                  config: MapConfig) -> EncounterGraph | None:
     """The largest component of ``graph`` among the region's events, if it is big enough
@@ -719,7 +740,7 @@ def _region_part(graph: EncounterGraph, labels: np.ndarray, region_events: np.nd
         return None
     sub = graph.subgraph(np.flatnonzero(labels == comp))
     agents = np.unique(np.concatenate([log.a[sub.event_index], log.b[sub.event_index]]))
-    return sub if len(agents) >= MIN_REGION_AGENTS else None
+    return sub if len(agents) >= MIN_REGION_AGENTS and sub.n_nodes >= 2 else None
 
 
 def software_versions() -> dict[str, str]:

@@ -13,8 +13,9 @@ swarm size in bigger arenas are sparser.  A team that does not know H gets the
 average over the benchmark's mix of hole counts (``PlanModel.holes_mix``).  The
 inverse questions solve the same equation for N or T.  The benchmark spans a range
 of densities, durations and hole counts (``density_range``, ``duration_range``,
-``len(holes_mix) - 1``); answers outside it are extrapolations and say so.
-Format /1 files (no hole term) are read with c3 = 0.
+``len(holes_mix) - 1``, and the swarm sizes ``agents_range``); answers outside it are
+extrapolations and say so.  Format /1 files (no hole term) are read with c3 = 0; files
+without ``agents_range`` check no swarm size.
 """
 
 from __future__ import annotations
@@ -52,6 +53,7 @@ class PlanModel:
     source: str
     holes_coef: float = 0.0
     holes_mix: tuple[float, ...] = (1.0,)  # fraction of the benchmark's maps with 0, 1, 2, ... holes
+    agents_range: tuple[float, float] | None = None  # swarm sizes the benchmark ran (None: not recorded)
 
     def accuracy(self, area: float, agents: float, duration: float, holes: int | None = None) -> float:
         """Expected exact-match accuracy of the default pipeline with ``holes`` holes
@@ -76,9 +78,10 @@ class PlanModel:
         return float(np.exp(log_t))
 
     def inside(self, area: float, agents: float, duration: float, holes: int | None = None) -> bool:
-        """Whether (N / A, T, H) lies in the range the benchmark measured."""
+        """Whether (N / A, N, T, H) lies in the range the benchmark measured."""
         density = agents / area
         return (self.density_range[0] <= density <= self.density_range[1]
+                and (self.agents_range is None or self.agents_range[0] <= agents <= self.agents_range[1])
                 and self.duration_range[0] <= duration <= self.duration_range[1]
                 and (holes is None or holes < len(self.holes_mix)))
 
@@ -105,7 +108,8 @@ class PlanModel:
         return {"format": PLAN_FORMAT, "intercept": self.intercept, "density_coef": self.density_coef,
                 "duration_coef": self.duration_coef, "holes_coef": self.holes_coef,
                 "holes_mix": list(self.holes_mix), "density_range": list(self.density_range),
-                "duration_range": list(self.duration_range), "maps": self.maps, "source": self.source}
+                "duration_range": list(self.duration_range), "maps": self.maps, "source": self.source,
+                **({} if self.agents_range is None else {"agents_range": list(self.agents_range)})}
 
     @classmethod
     def from_json(cls, obj: dict, source: str = "<json>") -> "PlanModel":
@@ -114,9 +118,15 @@ class PlanModel:
             model = cls(float(obj["intercept"]), float(obj["density_coef"]), float(obj["duration_coef"]),
                         tuple(map(float, obj["density_range"])), tuple(map(float, obj["duration_range"])),
                         int(obj["maps"]), str(obj["source"]), float(obj.get("holes_coef", 0.0)),
-                        tuple(map(float, obj.get("holes_mix", (1.0,)))))
+                        tuple(map(float, obj.get("holes_mix", (1.0,)))),
+                        tuple(map(float, obj["agents_range"])) if "agents_range" in obj else None)
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"malformed plan model: {exc!r}", file=source) from None
+        for name in ("density_range", "duration_range", "agents_range"):
+            bounds = getattr(model, name)
+            if bounds is not None and not (len(bounds) == 2 and all(np.isfinite(bounds)) and 0 < bounds[0] <= bounds[1]):
+                raise InputError("must be [low, high] with 0 < low <= high", file=source, column=name,
+                                 value=list(bounds))
         if not model.holes_mix or abs(sum(model.holes_mix) - 1.0) > 1e-6 or min(model.holes_mix) < 0:
             raise InputError("holes_mix must be fractions summing to 1", file=source, column="holes_mix",
                              value=list(model.holes_mix))
@@ -135,9 +145,11 @@ def fit_plan(records: Sequence[dict[str, Any]], source: str) -> PlanModel:
     X = np.column_stack([np.log(density), np.log(duration), holes])
     model = LogisticRegression(C=10.0).fit(X, right)
     mix = np.bincount(holes) / len(holes)
+    agents = np.array([r["agents"] for r in records], dtype=float)
     return PlanModel(float(model.intercept_[0]), float(model.coef_[0, 0]), float(model.coef_[0, 1]),
                      (float(density.min()), float(density.max())), (float(duration.min()), float(duration.max())),
-                     int(len(right)), source, float(model.coef_[0, 2]), tuple(float(w) for w in mix))
+                     int(len(right)), source, float(model.coef_[0, 2]), tuple(float(w) for w in mix),
+                     (float(agents.min()), float(agents.max())))
 
 
 def load_plan(path: str | Path | None = None) -> PlanModel:

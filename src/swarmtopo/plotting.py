@@ -98,15 +98,18 @@ def plot_point_cloud(coords: np.ndarray, color, ax=None, *, cmap="viridis", labe
 
 def plot_arena(arena, ax=None, *, points: np.ndarray | None = None, color=None, title=None):
     """The arena (free space grey, walls black) with optional points at true positions."""
+    from matplotlib.patches import PathPatch
+    from matplotlib.path import Path as DrawnPath
+
     ax = _axes(ax)
     for region in arena.regions:
-        x, y = region.exterior.xy
-        ax.fill(x, y, color="0.93", zorder=0)
-        ax.plot(x, y, color="k", lw=1.5)
-        for ring in region.interiors:
-            x, y = ring.xy
-            ax.fill(x, y, color="0.45", zorder=1)
-            ax.plot(x, y, color="k", lw=1.5)
+        for ring in region.interiors:  # obstacles under the free space, so a room inside a hole shows
+            ax.fill(*ring.xy, color="0.45", zorder=0)
+        rings = [region.exterior, *region.interiors]  # shell counter-clockwise, holes clockwise: holes cut out
+        free = DrawnPath.make_compound_path(*(DrawnPath(np.asarray(r.coords), closed=True) for r in rings))
+        ax.add_patch(PathPatch(free, facecolor="0.93", edgecolor="none", zorder=0.5))
+        for ring in rings:
+            ax.plot(*ring.xy, color="k", lw=1.5)
     if points is not None and len(points):
         ax.scatter(points[:, 0], points[:, 1], c=color, s=8, zorder=2)
     ax.set_aspect("equal")

@@ -244,6 +244,11 @@ class RatioClassifier:
             if unknown:
                 raise InputError(f"unknown confidence feature(s) {sorted(unknown)}; known: "
                                  f"{', '.join(REGION_FEATURES)}", column=f"calibration.{n}", value=model)
+            for key, value in model.items():
+                if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or (
+                        key == "rate" and not 0.0 <= value <= 1.0) or (key == "maps" and value < 0):
+                    raise InputError("must be a finite number" + (" in [0, 1]" if key == "rate" else ""),
+                                     column=f"calibration.{n}.{key}", value=value)
         self.thresholds_ = {int(n): th for n, th in sorted(thresholds.items())}
         self.calibration_ = dict(calibration or {})
         self.provenance_ = dict(provenance or {})
@@ -393,7 +398,9 @@ class RatioClassifier:
                 thresholds[int(n)] = RatioThresholds(float(t["q"]), float(t["tau"]))
             pooling = obj.get("pooling", "mean") if obj["format"] == RATIO_FORMAT else "median"
             return cls(thresholds, obj.get("calibration") or None, obj.get("provenance") or {}, pooling)
-        except InputError:
-            raise
+        except InputError as exc:
+            if exc.file is not None:
+                raise
+            raise InputError(exc.reason, file=source, row=exc.row, column=exc.column, value=exc.value) from None
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise InputError(f"malformed ratio classifier: {exc!r}", file=source) from None

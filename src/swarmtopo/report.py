@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .io import write_json
+from .io import make_folder, write_json
 from .log import EncounterLog
 from .pipeline import TopologicalMap
 from .report_html import write_report
@@ -24,7 +24,7 @@ def write_map_outputs(tmap: TopologicalMap, out_dir: Path, *, log: EncounterLog,
     ``trajectories`` (``io.read_trajectories``) adds the swarm animation to the report.
     """
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    make_folder(out_dir)
     written = [out_dir / "map.json", out_dir / "report.html", out_dir / "diagram.png"]
     doc = tmap.to_json()  # one document for map.json and the report: they cannot disagree
     write_json(doc, written[0])

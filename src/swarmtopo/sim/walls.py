@@ -24,6 +24,8 @@ import numpy as np
 import shapely
 from numba import njit
 
+from ..errors import SwarmtopoError
+
 agent_kernel = njit(cache=True, _nrt=False)
 """Decorator of the per-agent helpers (geometry here, the state machine in motion).
 
@@ -51,20 +53,27 @@ class WallGrid(NamedTuple):
     ncy: int
 
 
+MAX_WALL_CELLS = 50_000_000
+"""Most cells a wall grid may have (its CSR offsets take 8 bytes each: 400 MB)."""
+
+
 def build_wall_grid(segments: np.ndarray, bounds, cell: float, reach: float) -> WallGrid:
     """Bucket ``segments`` over ``bounds`` = (xmin, ymin, xmax, ymax) in cells of side ``cell``.
 
     A segment is listed in a cell when its distance to the cell rectangle is <= ``reach``.
+    Only cells near a wall are ever built (candidates along each segment, then the exact
+    test), so time and memory follow the walls' length, not the arena's area; an arena
+    of more than MAX_WALL_CELLS cells is refused.
     """
     segs = np.array(segments, dtype=np.float64, order="C").reshape(-1, 4)  # writable: one kernel type
     xmin, ymin, xmax, ymax = (float(v) for v in bounds)
     ncx = max(1, math.ceil((xmax - xmin) / cell))
     ncy = max(1, math.ceil((ymax - ymin) / cell))
-    cy, cx = np.divmod(np.arange(ncx * ncy), ncx)
-    boxes = shapely.box(xmin + cx * cell, ymin + cy * cell, xmin + (cx + 1) * cell, ymin + (cy + 1) * cell)
+    if ncx * ncy > MAX_WALL_CELLS:
+        raise SwarmtopoError(f"the arena is {xmax - xmin:.6g} x {ymax - ymin:.6g} mm, {ncx} x {ncy} cells of the "
+                             f"detection radius ({cell:g} mm), more than {MAX_WALL_CELLS:,}: are its coordinates in mm?")
     if len(segs):
-        tree = shapely.STRtree(shapely.linestrings(segs.reshape(-1, 2, 2)))
-        cell_id, seg_id = tree.query(boxes, predicate="dwithin", distance=reach)
+        cell_id, seg_id = _cells_near(segs, xmin, ymin, cell, reach, ncx, ncy)
         order = np.lexsort((seg_id, cell_id))
         cell_id, seg_id = cell_id[order], seg_id[order]
     else:
@@ -72,6 +81,35 @@ def build_wall_grid(segments: np.ndarray, bounds, cell: float, reach: float) -> 
     start = np.zeros(ncx * ncy + 1, np.int64)
     np.cumsum(np.bincount(cell_id, minlength=ncx * ncy), out=start[1:])
     return WallGrid(segs, start, seg_id.astype(np.int64), xmin, ymin, float(cell), ncx, ncy)
+
+
+def _cells_near(segs: np.ndarray, xmin: float, ymin: float, cell: float, reach: float, ncx: int, ncy: int):
+    """(cell, segment) pairs with the segment within ``reach`` of the cell rectangle.
+
+    Candidates: the cells within ceil(reach / cell) + 1 of points spaced at most half a
+    cell along each segment (every cell within reach of the segment is among them);
+    then shapely's exact ``dwithin`` of each candidate box and its segment.
+    """
+    lengths = np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1])
+    samples = np.ceil(2 * lengths / cell).astype(np.int64) + 1
+    seg_of = np.repeat(np.arange(len(segs)), samples)
+    offset = np.arange(len(seg_of)) - np.repeat(np.cumsum(samples) - samples, samples)
+    f = offset / np.maximum(samples - 1, 1)[seg_of]
+    x = segs[seg_of, 0] + f * (segs[seg_of, 2] - segs[seg_of, 0])
+    y = segs[seg_of, 1] + f * (segs[seg_of, 3] - segs[seg_of, 1])
+    pad = math.ceil(reach / cell) + 1
+    dx, dy = (d.ravel() for d in np.meshgrid(np.arange(-pad, pad + 1), np.arange(-pad, pad + 1)))
+    cx = (np.floor((x - xmin) / cell).astype(np.int64)[:, None] + dx).ravel()
+    cy = (np.floor((y - ymin) / cell).astype(np.int64)[:, None] + dy).ravel()
+    inside = (cx >= 0) & (cx < ncx) & (cy >= 0) & (cy < ncy)
+    n_cells = ncx * ncy
+    pairs = np.unique(np.repeat(seg_of, len(dx))[inside] * n_cells + (cy * ncx + cx)[inside])
+    seg_id, cell_id = np.divmod(pairs, n_cells)
+    cy, cx = np.divmod(cell_id, ncx)
+    boxes = shapely.box(xmin + cx * cell, ymin + cy * cell, xmin + (cx + 1) * cell, ymin + (cy + 1) * cell)
+    lines = shapely.linestrings(segs.reshape(-1, 2, 2))
+    near = shapely.dwithin(lines[seg_id], boxes, reach)
+    return cell_id[near], seg_id[near]
 
 
 def empty_wall_grid() -> WallGrid:
