@@ -166,6 +166,8 @@ def test_bad_option_values(simulated, tmp_path):
     for option, value in (("--dt", 0), ("--rd", -1), ("--duration", "inf"), ("--trajectories", 0)):
         assert_one_line_error(run("simulate", "--out", tmp_path / "z", option, value), f"'{option}'", code=2)
     assert_one_line_error(run("plan", "--area", 0, "--agents", 200, "--duration", 30), "'--area'", code=2)
+    for option, value in (("--hop-cost", 1e10), ("--wall-follow-weight", 1e7)):
+        assert_one_line_error(run("map", simulated[0], option, value), f"'{option}'", code=2)
     assert not (tmp_path / "z").exists()
 
 
@@ -268,7 +270,7 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     assert_one_line_error(run("map", simulated[0], "--diffusion-time", "0"), "positive number", code=2)
     assert_one_line_error(run("map", simulated[0], "--paper", "--wall-follow-weight", "1"),
                           "--paper fixes --wall-follow-weight", code=2)
-    assert_one_line_error(run("map", simulated[0], "--wall-follow-weight", "-1"), "number >= 0", code=2)
+    assert_one_line_error(run("map", simulated[0], "--wall-follow-weight", "-1"), "must be a number in [0, 1e+06]", code=2)
     assert_one_line_error(run("map", simulated[0], "--hop-cost", "-1"), "--hop-cost", code=2)
 
 

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import gzip
 import json
 import subprocess
 import sys
@@ -257,9 +258,10 @@ def test_ingest_refuses_to_overwrite_its_own_trace_and_says_what_it_removes(tmp_
     folder.mkdir()
     trace = folder / "events.parquet"
     pq.write_table(pa.table({"t": [1.0, 2.0], "a": [1, 2], "b": [2, 3]}), trace)
-    refused = run_cli("ingest", trace, "--format", "parquet", "--out", folder, "--overwrite")  # never the trace
-    assert refused.returncode == 1 and "write the log to another folder" in refused.stderr
-    assert "Traceback" not in refused.stderr and trace.is_file() and not (folder / "events.csv").exists()
+    for overwrite in ([], ["--overwrite"]):  # never the trace, and not first a hint to --overwrite
+        refused = run_cli("ingest", trace, "--format", "parquet", "--out", folder, *overwrite)
+        assert refused.returncode == 1 and "write the log to another folder" in refused.stderr
+        assert "Traceback" not in refused.stderr and trace.is_file() and not (folder / "events.csv").exists()
     other = tmp_path / "log"
     assert run_cli("ingest", trace, "--format", "parquet", "--out", other, "--log-format", "parquet").returncode == 0
     kept = run_cli("ingest", trace, "--format", "parquet", "--out", other)  # a log is there: not without --overwrite
@@ -274,6 +276,8 @@ def test_ingest_refuses_to_overwrite_its_own_trace_and_says_what_it_removes(tmp_
     (pa.array([1_400_000_000_000_000_000, 1_400_000_020_500_000_000], pa.timestamp("ns", tz="UTC")),
      [1_400_000_000.0, 1_400_000_020.5]),
     (pa.array([16_000, 16_001], pa.date32()), [16_000 * 86400.0, 16_001 * 86400.0]),
+    (pa.array([1_500, 61_000], pa.time32("ms")), [1.5, 61.0]),
+    (pa.array([1_500_000, 61_000_000], pa.time64("us")), [1.5, 61.0]),
 ])
 def test_parquet_date_and_time_columns_become_seconds(tmp_path, column, seconds):
     path = tmp_path / "trace.parquet"
@@ -354,7 +358,6 @@ def test_sociopatterns_text_as_editors_save_it(tmp_path, raw):
 
 
 def test_gzipped_text_traces_are_read_whatever_their_name(tmp_path):
-    import gzip
     path = tmp_path / "tij.dat"
     path.write_bytes(gzip.compress(b"20 1 2\n40 2 3\n"))
     log, _ = ingest(path, "sociopatterns")
@@ -365,11 +368,23 @@ def test_crlf_split_across_blocks_is_one_line_end(tmp_path, monkeypatch):
     raw = b"".join(f"{20 * k} {k % 7} {7 + k % 5}\r\n".encode() for k in range(1, 200))
     path = write(tmp_path, "tij.dat", raw, "wb")
     whole, whole_report = ingest(path, "sociopatterns")
-    for block in (5, 13, 14, 15):  # cuts before, at and after the \r\n of a 14-15 byte line
+    for block in (5, 9, 10, 11):  # cuts before, at and after the \r\n of 8-11 byte lines
         monkeypatch.setattr("swarmtopo.ingest._BLOCK", block)
         small, small_report = ingest(path, "sociopatterns")
         assert events(small) == events(whole) and small_report == whole_report
     assert whole_report.lines == 199 and whole_report.counts["blank_lines"] == 0
+
+
+@pytest.mark.parametrize("fmt, name, raw", [
+    ("one", "t.gz", gzip.compress(b"1 CONN 1 2 up\n")[:20]),  # truncated
+    ("sociopatterns", "g.dat", b"\x1f\x8b\x08\x00\x00\x00\x00\x00" + bytes(range(7, 107))),  # corrupt
+    ("csv", "t.csv.gz", gzip.compress(b"t,a,b\n1,1,2\n2,2,3\n")[:25]),
+])
+def test_a_broken_gzip_trace_is_one_line_naming_the_file(tmp_path, fmt, name, raw):
+    path = write(tmp_path, name, raw, "wb")
+    with pytest.raises(InputError) as caught:
+        ingest(path, fmt)
+    assert caught.value.file == str(path) and ("gzip" in str(caught.value) or "compressed" in str(caught.value))
 
 
 def test_not_utf8_mask_agrees_with_decoding_each_value():

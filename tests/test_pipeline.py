@@ -114,24 +114,22 @@ def test_encounters_all_at_one_time_get_a_clear_message():
 
 
 def test_empty_windows_do_not_take_seats_under_the_cap():
-    # events in [0, 10] and [100, 110]: of the 10 s windows every 5 s, only those over a burst hold events
-    t = np.r_[np.linspace(0.0, 10.0, 50), np.linspace(100.0, 110.0, 50)]
+    # bursts in [30, 40] and [60, 70] of a log from 0 to 110 s: of the 21 windows of 10 s every 5 s, only
+    # the two over a burst hold 40 events; an even share of all 21 would be the empty first and last ones
+    t = np.r_[0.0, np.linspace(30.0, 40.0, 50), np.linspace(60.0, 70.0, 50), 110.0]
+    assert _scaled_windows(t, [10.0], cap=2)[0] == [(0.0, 10.0), (100.0, 110.0)]
     spans, left_out = _scaled_windows(t, [10.0], cap=None, min_events=40)
-    assert spans == [(0.0, 10.0), (100.0, 110.0)] and left_out == 0
-    spans, left_out = _scaled_windows(t, [10.0], cap=2, min_events=40)  # all 21 windows would leave one burst out
-    assert spans == [(0.0, 10.0), (100.0, 110.0)] and left_out == 0
+    assert spans == [(30.0, 40.0), (60.0, 70.0)] and left_out == 0
+    assert _scaled_windows(t, [10.0], cap=2, min_events=40) == (spans, 0)
 
 
 def test_windows_too_short_to_list_are_refused_and_too_short_to_hold_a_region_say_so():
-    from swarmtopo.pipeline import MAX_WINDOWS_LISTED
-
     with pytest.raises(SwarmtopoError, match="would be 799,999, more than 100,000: use longer windows"):
         _windows(np.array([0.0, 40.0]), 1e-4)  # 1 + (40 - 1e-4) / 5e-5 windows
-    assert MAX_WINDOWS_LISTED == 100_000
     log = simulate(default_arena(), 100, 10.0, rng=3).log
-    tmap = map_encounters(log, MapConfig(window_length=0.01, window_scales=(1.0,), **FAST))
-    assert tmap.regions[0].warnings[0] == ("no window (0.01 s long) holds 50 encounters of this region among 3 "
-                                           "agents: its whole log was mapped instead")
+    tmap = map_encounters(log, MapConfig(window_length=0.01, window_scales=(1.0, 2.0), **FAST))
+    assert tmap.regions[0].warnings[0] == ("no window (0.01-0.02 s long) holds 50 encounters of this region "
+                                           "among 3 agents: its whole log was mapped instead")
     assert [(w.t0, w.t1) for w in tmap.regions[0].windows] == [(float(log.t.min()), float(log.t.max()))]
 
 

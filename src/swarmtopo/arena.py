@@ -511,7 +511,7 @@ def _units(feature: dict, source, where: str = "") -> float:
     """mm per unit of a Feature's coordinates (``properties.units``; mm when absent)."""
     properties = feature.get("properties")
     units = properties.get("units", "mm") if isinstance(properties, dict) else "mm"
-    if units not in MM_PER_UNIT:
+    if not isinstance(units, str) or units not in MM_PER_UNIT:
         raise ArenaError(f"{where}properties.units {units!r} is not supported; expected one of "
                          f"{', '.join(MM_PER_UNIT)}", file=source)
     return MM_PER_UNIT[units]

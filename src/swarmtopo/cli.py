@@ -39,8 +39,9 @@ OVERWRITE_HELP = "Replace the log already in --out (its log files are replaced o
 def _write_log_folder(log, out_dir: Path, quiet: bool, overwrite: bool, **options) -> list[Path]:
     """``io.write_log`` into a folder without a log, or over one with ``overwrite``,
     saying which outdated log files of the folder it removed."""
-    from .io import log_files, write_log
+    from .io import log_files, refuse_protected, write_log
 
+    refuse_protected(out_dir, options.get("protect", ()))  # before --overwrite could be suggested
     before = set(log_files(out_dir))
     if before and not overwrite:
         names = ", ".join(sorted(p.name for p in before))
@@ -211,6 +212,15 @@ def _parse_window(text: Optional[str]):
     return tuple(None if e is None or math.isinf(e) else e for e in ends)
 
 
+def _hop_cost_option(value: Optional[float]) -> Optional[float]:
+    """A --hop-cost value: seconds in [0, MAX_HOP_COST]."""
+    from .pipeline import MAX_HOP_COST
+
+    if value is not None and not (math.isfinite(value) and value <= MAX_HOP_COST):
+        raise typer.BadParameter(f"{value:g} is not a number of seconds in [0, {MAX_HOP_COST:g}]")
+    return value
+
+
 def _parse_wall_follow_weight(text: Optional[str]):
     """A --wall-follow-weight value: 'none' or a number >= 0."""
     if text is None or text == "none":
@@ -219,8 +229,10 @@ def _parse_wall_follow_weight(text: Optional[str]):
         value = float(text)
     except ValueError:
         raise typer.BadParameter(f"{text!r} is not a number or 'none'") from None
-    if not (math.isfinite(value) and value >= 0):
-        raise typer.BadParameter(f"{text!r} must be a number >= 0")
+    from .pipeline import MAX_WALL_FOLLOW_WEIGHT
+
+    if not (math.isfinite(value) and 0 <= value <= MAX_WALL_FOLLOW_WEIGHT):
+        raise typer.BadParameter(f"{text!r} must be a number in [0, {MAX_WALL_FOLLOW_WEIGHT:g}]")
     return text
 
 
@@ -278,7 +290,7 @@ def map_command(
     maxdim: int = typer.Option(1, "--maxdim", min=1, max=2, help="Highest homology dimension (1 or 2)."),
     seed: int = typer.Option(0, "--seed", min=0, help="Seed of landmark start and MDS."),
     hop_cost: Optional[float] = typer.Option(
-        None, "--hop-cost", min=0.0,
+        None, "--hop-cost", min=0.0, callback=_hop_cost_option,
         help="Per-hop cost h in seconds on the encounter graph; 0 = the paper's metric "
              "(default: r_d / v_c from meta.json, else from the data)."),
     diffusion_time: Optional[str] = typer.Option(

@@ -42,6 +42,7 @@ lines are not malformed: they are counted and ignored.
 from __future__ import annotations
 
 import gzip
+import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -423,6 +424,8 @@ def _csv_batches(path: Path, names: dict[str, str], rows: _Rows):
         if "UTF8" in str(exc):
             raise InputError("not UTF-8 text; save the file as UTF-8", file=str(path)) from None
         raise InputError(f"cannot parse CSV ({exc})", file=str(path)) from None
+    except OSError as exc:  # a truncated or corrupt .gz
+        raise InputError(f"cannot read the file ({exc})", file=str(path)) from None
 
 
 def _column_of(header: list[str], name: str, path: Path) -> str:
@@ -441,7 +444,7 @@ def _csv_header(path: Path) -> list[str]:
         with pcsv.open_csv(path, read_options=pcsv.ReadOptions(block_size=1 << 16),
                            parse_options=pcsv.ParseOptions(invalid_row_handler=lambda row: "skip")) as reader:
             return reader.schema.names
-    except (pa.ArrowInvalid, UnicodeDecodeError) as exc:
+    except (pa.ArrowInvalid, UnicodeDecodeError, OSError) as exc:
         raise InputError(f"cannot read the CSV header ({exc})", file=str(path)) from None
 
 
@@ -453,7 +456,6 @@ def _parquet_batches(path: Path, names: dict[str, str], rows: _Rows):
         raise InputError(f"cannot read Parquet file ({exc})", file=str(path)) from None
     schema = pf.schema_arrow
     names = {key: _column_of(schema.names, col, path) for key, col in names.items()}
-    indices = {key: schema.names.index(col) for key, col in names.items()}
     start = 0
     for batch in pf.iter_batches(batch_size=1 << 18, columns=list(dict.fromkeys(names.values()))):
         cols = {}
@@ -472,7 +474,7 @@ def _parquet_batches(path: Path, names: dict[str, str], rows: _Rows):
                     arr = pc.cast(arr, pa.string())  # Parquet values are exact: not trimmed
                 except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
                     raise InputError(f"column of type {arr.type} cannot hold {'times' if key == 't' else 'agent IDs'}",
-                                     file=str(path), column=schema.names[indices[key]]) from None
+                                     file=str(path), column=col) from None
             cols[key] = arr
         rows.lines += batch.num_rows
         yield np.arange(start + 1, start + batch.num_rows + 1), cols
@@ -488,6 +490,8 @@ def _seconds(arr: pa.Array) -> pa.Array:
     if pa.types.is_date32(arr.type):
         return pc.multiply(pc.cast(arr.view(pa.int32()), pa.float64()), 86400.0)
     unit = "ms" if pa.types.is_date64(arr.type) else arr.type.unit
+    if pa.types.is_time32(arr.type):  # no cast to int64 in Arrow: read its 32-bit counts
+        return pc.multiply(pc.cast(arr.view(pa.int32()), pa.float64()), _SECONDS_PER_UNIT[unit])
     return pc.multiply(pc.cast(pc.cast(arr, pa.int64()), pa.float64(), safe=False), _SECONDS_PER_UNIT[unit])
 
 
@@ -499,10 +503,10 @@ def _text_batches(path: Path, rows: _Rows):
     """
     line_no = 0
     with _open_text(path) as f:
-        tail = f.read(3)
+        tail = _read(f, 3, path)
         tail = tail[3:] if tail == b"\xef\xbb\xbf" else tail  # a UTF-8 byte order mark
         while True:
-            block = f.read(_BLOCK)
+            block = _read(f, _BLOCK, path)
             data = tail + block
             if block:
                 # cut after the last line end; a final \r waits: a \n may follow in the next block
@@ -528,6 +532,14 @@ def _text_batches(path: Path, rows: _Rows):
             yield numbers, fields, pc.list_value_length(fields).to_numpy(zero_copy_only=False).astype(np.int64)
             if not block:
                 return
+
+
+def _read(f, size: int, path: Path) -> bytes:
+    """``f.read(size)``; a truncated or corrupt gzip stream is refused naming the file."""
+    try:
+        return f.read(size)
+    except (OSError, EOFError, zlib.error) as exc:
+        raise InputError(f"cannot decompress the gzip file ({exc})", file=str(path)) from None
 
 
 def _open_text(path: Path):

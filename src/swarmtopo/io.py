@@ -120,11 +120,7 @@ def write_log(
     if fmt not in FORMATS:
         raise SwarmtopoError(f"unknown log format {fmt!r}; expected one of {', '.join(FORMATS)}")
     directory = Path(directory)
-    protected = {Path(p).resolve() for p in protect}
-    for path in log_files(directory):
-        if path.resolve() in protected:
-            raise InputError("the log folder would overwrite or delete this file; write the log to another "
-                             "folder", file=str(path))
+    refuse_protected(directory, protect)
     make_folder(directory)
     ids_a, ids_b = log.ids_of(log.a), log.ids_of(log.b)
     tables = {"events": {"t": log.t, "a": ids_a, "b": ids_b}}
@@ -152,6 +148,16 @@ def write_log(
             except OSError as exc:
                 raise InputError(f"cannot delete an outdated log file ({_os_reason(exc)})", file=str(path)) from None
     return written
+
+
+def refuse_protected(directory, protect) -> None:
+    """InputError if one of the files ``protect`` is a log file of ``directory``
+    (:func:`write_log` would overwrite or delete it)."""
+    protected = {Path(p).resolve() for p in protect}
+    for path in log_files(directory):
+        if path.resolve() in protected:
+            raise InputError("the log folder would overwrite or delete this file; write the log to another "
+                             "folder", file=str(path))
 
 
 def log_files(directory) -> list[Path]:

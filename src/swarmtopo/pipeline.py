@@ -40,13 +40,13 @@ from .ratio import longest_bars, vote
 
 
 MIN_REGION_AGENTS = 3
+"""Distinct agents a component needs to count as a region (two agents alone that keep
+meeting say nothing about the arena)."""
 MAX_HOP_COST, MAX_WALL_FOLLOW_WEIGHT = 1e9, 1e6
 """Bounds of the per-hop cost (s, about 30 years) and of the wall-following charge (s/s):
 far beyond any log, and far below where squared distances overflow in MDS."""
 MAX_WINDOWS_LISTED = 100_000
 """Most windows of one length a log may be cut into before the cap picks its share."""
-"""Distinct agents a component needs to count as a region (two agents alone that keep
-meeting say nothing about the arena)."""
 AUTO_COVER_FACTOR = 1.5
 """The automatic landmark count stops once r_cover <= AUTO_COVER_FACTOR * s (s: the
 region's k-NN scale).  The landmarks' diagram is within bottleneck 2 r_cover of the
@@ -460,7 +460,7 @@ def map_encounters(
     agents_per_comp = _agents_per_component(log, graph.event_index, event_comp, n_comp)
     timings["graph"] = time.perf_counter() - t0
 
-    if graph.event_t.min() == graph.event_t.max():
+    if graph.n_events >= 2 and graph.event_t.min() == graph.event_t.max():
         raise SwarmtopoError(f"all {graph.n_events} encounters are at one time (t = {exact_time(graph.event_t[0])} s); "
                              f"a map needs encounters spread over time")
     is_region = ((events_per_comp >= config.min_region_events) & (agents_per_comp >= MIN_REGION_AGENTS)
@@ -482,6 +482,7 @@ def map_encounters(
         resolve_window(agent_gap, None if config.window_length is None else scale * config.window_length,
                        scale * config.window_encounters, log_span)[0] for scale in config.window_scales],
         config.window_step, config.max_windows, config.min_region_events)
+    lengths_tried = sorted({span[1] - span[0] for span in spans if span is not None})
     window_graphs = []  # (span, graph, component labels) of each window
     for span in spans:
         if span is None:  # the whole log: a scale whose windows would not be shorter than it
@@ -502,8 +503,11 @@ def map_encounters(
         if not windows:  # no window holds enough of this region: map its whole log instead
             whole = graph.subgraph(np.flatnonzero(labels == comp))
             windows = [_map_window(None, whole, n_land, config, rng, timings, say)]
-            fallback = [f"no window ({window_length:.3g} s long) holds {config.min_region_events} encounters of "
-                        f"this region among {MIN_REGION_AGENTS} agents: its whole log was mapped instead"]
+            if lengths_tried:
+                lo, hi = lengths_tried[0], lengths_tried[-1]
+                tried = f"{lo:.3g}" if lo == hi else f"{lo:.3g}-{hi:.3g}"
+                fallback = [f"no window ({tried} s long) holds {config.min_region_events} encounters of this region "
+                            f"among {MIN_REGION_AGENTS} agents: its whole log was mapped instead"]
         say("classify")
         t0 = time.perf_counter()
         diagrams = [w.diagram for w in windows]
