@@ -157,7 +157,13 @@ def test_overlapping_holes_arena_is_one_line(tmp_path):
 
 def test_bad_option_values(simulated, tmp_path):
     assert_one_line_error(run("map", simulated[0], "--out", tmp_path / "x", "--metric", "euclid"),
-                          "unknown metric 'euclid'")
+                          "unknown metric 'euclid'", code=2)
+    assert_one_line_error(run("map", simulated[0], "--max-windows", 2), "at least the number of window scales", code=2)
+    assert_one_line_error(run("map", simulated[0], "--landmarks", 2001), "'--landmarks'", code=2)
+    for window in ("inf:", ":-inf"):
+        assert_one_line_error(run("map", simulated[0], "--window", window), "would hold nothing", code=2)
+    assert_one_line_error(run("map", simulated[0], "--window", "1e9:2e9"),
+                          "no encounter events in the window [1000000000, 2000000000] s; the log's events run from")
     assert_one_line_error(run("map", simulated[0], "--window", "abc"), "T0:T1", code=2)
     assert_one_line_error(run("simulate", "--format", "xml", "--out", tmp_path / "y"), "xml", code=2)
     for command in (["map", simulated[0]], ["simulate", "--out", tmp_path / "z"], ["demo", "--out", tmp_path / "w"]):
@@ -256,7 +262,7 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     assert doc["params"]["max_windows"] is None and len(doc["regions"][0]["windows"]) > 3
     for bad in ("0", "-1", "2.5", "abc"):
         assert_one_line_error(run("map", simulated[0], "--max-windows", bad), "whole number >= 1", code=2)
-    assert_one_line_error(run("map", simulated[0], "--max-windows", "2"), "at least the number of window scales")
+    assert_one_line_error(run("map", simulated[0], "--max-windows", "2"), "at least the number of window scales", code=2)
     assert_one_line_error(run("map", simulated[0], "--paper", "--max-windows", "5"), "--paper fixes --max-windows",
                           code=2)
     assert_one_line_error(run("map", simulated[0], "--window-scales", "1,0"), "distinct positive numbers", code=2)

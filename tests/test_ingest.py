@@ -332,7 +332,7 @@ def test_duplicate_events_quote_both_file_rows_and_the_exact_time(tmp_path):
     path = write(tmp_path, "trace.csv", "t,a,b\n5,7,8\n\n6,x,x\n1400028780,1,2\n1400028780,2,1\n")
     with pytest.raises(InputError) as caught:
         ingest(path, "csv", skip_bad=True)
-    assert caught.value.row == 5 and "as row 4" in str(caught.value)
+    assert caught.value.row == 5 and "as row 4 (a pair is unordered: a -> b and b -> a at one time" in str(caught.value)
     assert caught.value.value == "1400028780, 1, 2"
 
 

@@ -446,3 +446,14 @@ def test_windows_in_a_gap_of_the_trace_are_skipped():
     spans = [(w.t0, w.t1) for w in tmap.regions[0].windows]
     assert spans and all(np.any((log.t >= t0) & (log.t <= t1)) for t0, t1 in spans)
     assert len(spans) < len(_windows(log.t, 20.0))
+
+
+def test_the_whole_log_fallback_is_said_even_when_no_window_holds_enough_events():
+    # 60 agents meeting at a steady pace for 100 s: 1 s windows never hold 50 encounters
+    rng = np.random.default_rng(4)
+    t = np.sort(rng.uniform(0.0, 100.0, 3000))
+    a = rng.integers(0, 60, len(t))
+    b = (a + rng.integers(1, 60, len(t))) % 60
+    log = EncounterLog.from_records(t, a, b)
+    tmap = map_encounters(log, MapConfig(window_length=0.5, window_scales=(1.0, 2.0), **FAST))
+    assert tmap.regions[0].warnings[0].startswith("no window (0.5-1 s long) holds 50 encounters")

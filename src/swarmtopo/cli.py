@@ -28,6 +28,8 @@ app = typer.Typer(
 )
 out = Console()
 err = Console(stderr=True)
+MAX_LANDMARKS_OPTION = 2000
+"""Most landmarks --landmarks may ask for per window (800 took about 1 GB and 80 s per window on a trace)."""
 DEMO_AGENTS, DEMO_SECONDS = 200, 30.0
 """The demo's swarm: the accuracy benchmark's smallest budget."""
 VERBOSE_HELP = "Also report each stage's details and timings on stderr (in pipes too)."
@@ -209,6 +211,8 @@ def _parse_window(text: Optional[str]):
         raise typer.BadParameter(f"{text!r} is not T0:T1 with numbers in seconds") from None
     if any(e is not None and math.isnan(e) for e in ends):
         raise typer.BadParameter(f"{text!r}: a window end cannot be NaN")
+    if ends[0] == math.inf or ends[1] == -math.inf:
+        raise typer.BadParameter(f"{text!r}: a window cannot start at +inf or end at -inf (it would hold nothing)")
     return tuple(None if e is None or math.isinf(e) else e for e in ends)
 
 
@@ -282,9 +286,9 @@ def map_command(
     metric: str = typer.Option("hybrid", "--metric", help="plain | contracted | hybrid (paper's metrics)."),
     subsample: str = typer.Option("maxmin", "--subsample", help="maxmin | knn | probabilistic."),
     landmarks: Optional[int] = typer.Option(
-        None, "--landmarks", min=3, max=10**9,
+        None, "--landmarks", min=3, max=MAX_LANDMARKS_OPTION,
         help="Number of landmarks L per region and window (default: the fewest that meet the sampling "
-             "guarantee, at most 400)."),
+             f"guarantee, at most 400; at most {MAX_LANDMARKS_OPTION}: persistence time grows about as L^3)."),
     window: Optional[str] = typer.Option(None, "--window", callback=_parse_window,
                                          help="Time window T0:T1 in seconds (either end may be empty)."),
     maxdim: int = typer.Option(1, "--maxdim", min=1, max=2, help="Highest homology dimension (1 or 2)."),
@@ -331,6 +335,7 @@ def map_command(
     """Map an encounter log folder: Betti numbers with confidence, diagrams and pictures."""
     from .classify import load_classifier
     from .io import read_log
+    from .log import exact_time
     from .pipeline import MapConfig, max_windows_option, seconds_option, wall_follow_option
 
     _check_verbosity(quiet, verbose)
@@ -347,16 +352,20 @@ def map_command(
     out_dir = out_dir or log_dir / "map"
     if out_dir.exists() and not out_dir.is_dir():
         raise SwarmtopoError(f"{out_dir}: --out is a file; give a folder for the map's outputs")
-    config = MapConfig(metric=metric, subsample=subsample, landmarks=landmarks, window=window, maxdim=maxdim,
-                       seed=seed, hop_cost=hop_cost, diffusion_time=seconds_option(diffusion_time),
-                       wall_follow_weight=wall_follow_option(wall_follow_weight),
-                       window_length=seconds_option(window_length),
-                       window_scales=window_scales or MapConfig.window_scales,
-                       max_windows=max_windows_option(max_windows)).validate()
+    try:
+        config = MapConfig(metric=metric, subsample=subsample, landmarks=landmarks, window=window, maxdim=maxdim,
+                           seed=seed, hop_cost=hop_cost, diffusion_time=seconds_option(diffusion_time),
+                           wall_follow_weight=wall_follow_option(wall_follow_weight),
+                           window_length=seconds_option(window_length),
+                           window_scales=window_scales or MapConfig.window_scales,
+                           max_windows=max_windows_option(max_windows)).validate()
+    except SwarmtopoError as exc:  # options that do not go together: a usage error
+        raise typer.BadParameter(str(exc)) from None
     model = load_classifier(classifier) if classifier else None  # None: the shipped one for the log
     log = read_log(log_dir)
     if verbose:
-        _detail(f"log {log_dir}: {log.n_events} encounters of {log.n_agents} agents over {log.duration:g} s")
+        _detail(f"log {log_dir}: {log.n_events} encounters of {log.n_agents} agents from t = {exact_time(log.t[0])} "
+                f"to {exact_time(log.t[-1])} s")
     tmap, written = _run_map(log, config, log_dir, out_dir, quiet, verbose, classifier=model)
     if not quiet:
         _print_verdict(tmap, truth=None)

@@ -121,7 +121,7 @@ from scipy.sparse.csgraph import connected_components, csgraph_from_dense, dijks
 
 from ._validate import non_negative, positive
 from .errors import InputError
-from .log import WF, EncounterLog
+from .log import WF, EncounterLog, exact_time
 
 METRICS: tuple[str, ...] = ("plain", "contracted", "hybrid")
 """Encounter metrics: paper's plain encounter metric, contracted, hybrid network."""
@@ -416,8 +416,8 @@ def _window_slice(log: EncounterLog, window) -> tuple[int, int]:
     if stop <= start:
         if log.n_events == 0:
             raise InputError("the encounter log has no events")
-        raise InputError(f"no encounter events in the window [{lo:g}, {hi:g}]", column="window",
-                         value=window)
+        raise InputError(f"no encounter events in the window [{exact_time(lo)}, {exact_time(hi)}] s; the log's "
+                         f"events run from {exact_time(log.t[0])} to {exact_time(log.t[-1])} s")
     return start, stop
 
 

@@ -181,7 +181,8 @@ class EncounterLog:
         if dup.any():
             k = int(np.argmax(dup))
             r1, r2 = sorted((row(order[k]), row(order[k + 1])))
-            raise InputError(f"duplicate event: same time and pair as row {r1}", file=src_e, row=r2,
+            raise InputError(f"duplicate event: same time and pair as row {r1} (a pair is unordered: a -> b and "
+                             f"b -> a at one time are one encounter; keep one row)", file=src_e, row=r2,
                              value=f"{exact_time(t[k])}, {agent_ids[lo[k]]}, {agent_ids[hi[k]]}")
 
         st_order = np.lexsort((st_t, cst))

@@ -478,11 +478,11 @@ def map_encounters(
               else [None] * len(regions_idx))
     log_span = float(graph.event_t.max() - graph.event_t.min())
     window_length, window_source = resolve_window(agent_gap, config.window_length, config.window_encounters, log_span)
-    spans, left_out = _scaled_windows(graph.event_t, [
-        resolve_window(agent_gap, None if config.window_length is None else scale * config.window_length,
-                       scale * config.window_encounters, log_span)[0] for scale in config.window_scales],
-        config.window_step, config.max_windows, config.min_region_events)
-    lengths_tried = sorted({span[1] - span[0] for span in spans if span is not None})
+    lengths = [resolve_window(agent_gap, None if config.window_length is None else scale * config.window_length,
+                              scale * config.window_encounters, log_span)[0] for scale in config.window_scales]
+    spans, left_out = _scaled_windows(graph.event_t, lengths, config.window_step, config.max_windows,
+                                      config.min_region_events)
+    lengths_tried = sorted(length for length in lengths if length < log_span)  # the others map the whole log
     window_graphs = []  # (span, graph, component labels) of each window
     for span in spans:
         if span is None:  # the whole log: a scale whose windows would not be shorter than it
