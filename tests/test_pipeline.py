@@ -457,3 +457,18 @@ def test_the_whole_log_fallback_is_said_even_when_no_window_holds_enough_events(
     log = EncounterLog.from_records(t, a, b)
     tmap = map_encounters(log, MapConfig(window_length=0.5, window_scales=(1.0, 2.0), **FAST))
     assert tmap.regions[0].warnings[0].startswith("no window (0.5-1 s long) holds 50 encounters")
+
+
+def test_a_silence_longer_than_a_window_is_a_warning_and_a_day_mapped_alone_has_none():
+    # two "days" of steady meetings, 100 s each, 10^4 s apart
+    rng = np.random.default_rng(5)
+    t = np.sort(np.r_[rng.uniform(0.0, 100.0, 3000), rng.uniform(10_100.0, 10_200.0, 3000)])
+    a = rng.integers(0, 60, len(t))
+    b = (a + rng.integers(1, 60, len(t))) % 60
+    log = EncounterLog.from_records(t, a, b)
+    whole = map_encounters(log, MapConfig(**FAST))
+    gap = float(np.diff(t).max())
+    assert whole.warnings[0].startswith(f"the log is silent for {gap:.6g} s") and "--window T0:T1" in whole.warnings[0]
+    assert whole.to_json()["warnings"][0] == whole.warnings[0]
+    day = map_encounters(log, MapConfig(window=(0.0, 100.0), **FAST))
+    assert not any("silent" in w for w in day.warnings)

@@ -344,11 +344,12 @@ class TopologicalMap:
     window_length: tuple[float, str] = (WHOLE_LOG, "given")  # (window length used, where it came from)
     windows_left_out: int = 0  # windows the cap (MapConfig.max_windows) left unmapped
     software: dict[str, str] = field(default_factory=dict)
+    log_warnings: list[str] = field(default_factory=list)  # about the mapped log as a whole
 
     @property
     def warnings(self) -> list[str]:
-        """Reasons to doubt the map, from every region."""
-        return [w for r in self.regions for w in r.warnings]
+        """Reasons to doubt the map: the log's, then every region's."""
+        return self.log_warnings + [w for r in self.regions for w in r.warnings]
 
     def advice(self) -> list[str]:
         """What would raise a confidence below ``ADVICE_BELOW`` (empty otherwise)."""
@@ -577,6 +578,7 @@ def map_encounters(
         diffusion_time=(diffusion_time, diffusion_source),
         window_length=(window_length, window_source),
         windows_left_out=left_out,
+        log_warnings=_silence_warnings(graph.event_t, window_length),
         software=software_versions(),
     )
 
@@ -729,6 +731,19 @@ def _evenly(n: int, k: int) -> np.ndarray:
     if k == 1:
         return np.array([(n - 1) // 2])
     return np.unique(np.linspace(0, n - 1, k).round().astype(int))
+
+
+def _silence_warnings(event_t: np.ndarray, window_length: float) -> list[str]:
+    """A silence in the log longer than a window (a night in a multi-day trace): it
+    stretches the mean gap the automatic h, windows and diffusion time come from."""
+    times = np.sort(event_t)
+    gaps = np.diff(times)
+    if not len(gaps) or not np.isfinite(window_length) or gaps.max() <= window_length:
+        return []
+    k = int(np.argmax(gaps))
+    return [f"the log is silent for {gaps[k]:.6g} s (t = {exact_time(times[k])} to {exact_time(times[k + 1])}), "
+            f"longer than a window ({window_length:.3g} s): silences such as nights inflate the automatic per-hop "
+            f"cost and windows; map each active period with --window T0:T1"]
 
 
 def _region_part(graph: EncounterGraph, labels: np.ndarray, region_events: np.ndarray, log: EncounterLog,
