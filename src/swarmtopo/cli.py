@@ -38,12 +38,13 @@ VERBOSE_HELP = "Also report each stage's details and timings on stderr (in pipes
 OVERWRITE_HELP = "Replace the log already in --out (its log files are replaced or removed)."
 
 
-def _write_log_folder(log, out_dir: Path, quiet: bool, overwrite: bool, **options) -> list[Path]:
+def _write_log_folder(log, out_dir: Path, quiet: bool, overwrite: bool, protect=(), **options) -> list[Path]:
     """``io.write_log`` into a folder without a log, or over one with ``overwrite``,
-    saying which outdated log files of the folder it removed."""
+    saying which outdated log files of the folder it removed; never over a file of
+    ``protect`` (the trace an ingest reads)."""
     from .io import log_files, refuse_protected, write_log
 
-    refuse_protected(out_dir, options.get("protect", ()))  # before --overwrite could be suggested
+    refuse_protected(out_dir, protect)  # before --overwrite could be suggested
     before = set(log_files(out_dir))
     if before and not overwrite:
         names = ", ".join(sorted(p.name for p in before))

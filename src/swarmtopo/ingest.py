@@ -487,12 +487,13 @@ _SECONDS_PER_UNIT = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 def _seconds(arr: pa.Array) -> pa.Array:
     """A date, time, timestamp or duration column as float64 seconds (dates and
     timestamps since 1970-01-01, times of day since midnight); nulls stay null."""
-    if pa.types.is_date32(arr.type):
-        return pc.multiply(pc.cast(arr.view(pa.int32()), pa.float64()), 86400.0)
-    unit = "ms" if pa.types.is_date64(arr.type) else arr.type.unit
-    if pa.types.is_time32(arr.type):  # no cast to int64 in Arrow: read its 32-bit counts
-        return pc.multiply(pc.cast(arr.view(pa.int32()), pa.float64()), _SECONDS_PER_UNIT[unit])
-    return pc.multiply(pc.cast(pc.cast(arr, pa.int64()), pa.float64(), safe=False), _SECONDS_PER_UNIT[unit])
+    kind = arr.type
+    if pa.types.is_date32(kind) or pa.types.is_time32(kind):  # no cast to int64 in Arrow: their 32-bit counts
+        counts = arr.view(pa.int32())
+    else:
+        counts = pc.cast(arr, pa.int64())
+    seconds = 86400.0 if pa.types.is_date32(kind) else _SECONDS_PER_UNIT["ms" if pa.types.is_date64(kind) else kind.unit]
+    return pc.multiply(pc.cast(counts, pa.float64(), safe=False), seconds)
 
 
 def _text_batches(path: Path, rows: _Rows):
@@ -632,7 +633,7 @@ def _times(col: pa.Array, line, name: str, rows: _Rows, *, minimum: float, activ
     reason = below or ("time must not be negative" if minimum == 0 else f"time must be >= {minimum:g}")
     ok &= rows.reject(active & ok & ~(t >= minimum), line, name, col, reason)
     ok &= rows.reject(active & ok & (t >= MAX_TIME), line, name, col, TOO_LATE)
-    return t + 0.0, ok & active  # + 0.0: -0.0 -> 0.0
+    return t, ok & active
 
 
 def _ids_ok(a: pa.Array, b: pa.Array, line, names: tuple[str, str], rows: _Rows, active=None) -> np.ndarray:

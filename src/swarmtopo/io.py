@@ -83,7 +83,6 @@ def write_log(
     truth: dict | None = None,
     trajectories: dict | None = None,
     arena: Arena | None = None,
-    protect=(),
 ) -> list[Path]:
     """Write a log folder (see the module docstring); returns the paths written.
 
@@ -113,14 +112,10 @@ def write_log(
         (strings or codes into STATES) and extra columns.
     arena
         The true arena, written as ``arena.geojson``.
-    protect
-        Files that must survive (the trace an ingest reads): if one of them is a
-        contract file of the folder, nothing is written and InputError says so.
     """
     if fmt not in FORMATS:
         raise SwarmtopoError(f"unknown log format {fmt!r}; expected one of {', '.join(FORMATS)}")
     directory = Path(directory)
-    refuse_protected(directory, protect)
     make_folder(directory)
     ids_a, ids_b = log.ids_of(log.a), log.ids_of(log.b)
     tables = {"events": {"t": log.t, "a": ids_a, "b": ids_b}}
@@ -209,9 +204,8 @@ def read_log(directory) -> EncounterLog:
         t, ids[0], ids[1], status=status_cols, static=static_cols, meta=meta,
         source={"events": str(events_path), "status": str(status_path), "static": f"{meta_path} static"},
     )
-    last = max([float(x.max()) for x in (log.t, log.status_t) if len(x)], default=0.0)
-    if "duration" in meta and meta["duration"] < last:
-        raise InputError(f"key 'duration' is {meta['duration']:g} s but the log runs to t = {last:g} s",
+    if "duration" in meta and meta["duration"] < log.last_time:
+        raise InputError(f"key 'duration' is {meta['duration']:g} s but the log runs to t = {log.last_time:g} s",
                          file=str(meta_path), column="duration", value=meta["duration"])
     return log
 
@@ -741,10 +735,11 @@ def _read_meta(path: Path) -> dict:
             if isinstance(v, bool) or not isinstance(v, (int, str)) or (isinstance(v, str) and not v.strip()):
                 raise InputError(f"key 'agent_ids': entry {i + 1} must be an integer or a non-empty text",
                                  file=str(path), value=v)
-        if len(set(map(str, ids))) != len(ids):
-            seen: set = set()
-            twice = next(v for v in ids if str(v) in seen or seen.add(str(v)))
-            raise InputError("key 'agent_ids' lists an agent twice", file=str(path), column="agent_ids", value=twice)
+        seen: set[str] = set()
+        for v in ids:
+            if str(v) in seen:
+                raise InputError("key 'agent_ids' lists an agent twice", file=str(path), column="agent_ids", value=v)
+            seen.add(str(v))
         if count is not None and count != len(ids):
             raise InputError(f"key 'agent_count' is {count} but 'agent_ids' lists {len(ids)} agents",
                              file=str(path), value=count)

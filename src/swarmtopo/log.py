@@ -210,11 +210,15 @@ class EncounterLog:
 
     @property
     def duration(self) -> float:
-        """Declared duration (meta ``duration``), else the last event or status time."""
+        """Declared duration (meta ``duration``), else :attr:`last_time`."""
         if "duration" in self.meta:
             return float(self.meta["duration"])
-        ends = [x.max() for x in (self.t, self.status_t) if len(x)]
-        return float(max(ends)) if ends else 0.0
+        return self.last_time
+
+    @property
+    def last_time(self) -> float:
+        """The last event or status time (0 for an empty log)."""
+        return max((float(x.max()) for x in (self.t, self.status_t) if len(x)), default=0.0)
 
     def window(self, t0: float | None = None, t1: float | None = None) -> "EncounterLog":
         """Events with t0 <= t <= t1; status and static agents are kept whole."""

@@ -461,8 +461,9 @@ def map_encounters(
     agents_per_comp = _agents_per_component(log, graph.event_index, event_comp, n_comp)
     timings["graph"] = time.perf_counter() - t0
 
-    if graph.n_events >= 2 and graph.event_t.min() == graph.event_t.max():
-        raise SwarmtopoError(f"all {graph.n_events} encounters are at one time (t = {exact_time(graph.event_t[0])} s); "
+    times = np.sort(graph.event_t)  # the mapped events' times, for the span, the windows and the silences
+    if graph.n_events >= 2 and times[0] == times[-1]:
+        raise SwarmtopoError(f"all {graph.n_events} encounters are at one time (t = {exact_time(times[0])} s); "
                              f"a map needs encounters spread over time")
     is_region = ((events_per_comp >= config.min_region_events) & (agents_per_comp >= MIN_REGION_AGENTS)
                  & (np.bincount(labels, minlength=n_comp) >= 2))  # one node: its encounters all at one instant
@@ -477,11 +478,11 @@ def map_encounters(
 
     shares = (_share_landmarks(config.landmarks, events_per_comp[regions_idx]) if config.landmarks
               else [None] * len(regions_idx))
-    log_span = float(graph.event_t.max() - graph.event_t.min())
+    log_span = float(times[-1] - times[0])
     window_length, window_source = resolve_window(agent_gap, config.window_length, config.window_encounters, log_span)
     lengths = [resolve_window(agent_gap, None if config.window_length is None else scale * config.window_length,
                               scale * config.window_encounters, log_span)[0] for scale in config.window_scales]
-    spans, left_out = _scaled_windows(graph.event_t, lengths, config.window_step, config.max_windows,
+    spans, left_out = _scaled_windows(times, lengths, config.window_step, config.max_windows,
                                       config.min_region_events)
     lengths_tried = sorted(length for length in lengths if length < log_span)  # the others map the whole log
     window_graphs = []  # (span, graph, component labels) of each window
@@ -578,7 +579,7 @@ def map_encounters(
         diffusion_time=(diffusion_time, diffusion_source),
         window_length=(window_length, window_source),
         windows_left_out=left_out,
-        log_warnings=_silence_warnings(graph.event_t, window_length),
+        log_warnings=_silence_warnings(times, window_length),
         software=software_versions(),
     )
 
@@ -679,11 +680,11 @@ def _windows(event_t: np.ndarray, length: float, step: float | None = None) -> l
     return [(float(s), float(s) + length) for s in np.linspace(t_first, t_last - length, n)]
 
 
-def _scaled_windows(event_t: np.ndarray, lengths, step: float | None = None, cap: int | None = None,
+def _scaled_windows(times: np.ndarray, lengths, step: float | None = None, cap: int | None = None,
                     min_events: int = 0) -> tuple[list[tuple[float, float] | None], int]:
-    """The distinct windows of every length in ``lengths`` (:func:`_windows`) that hold at
-    least ``min_events`` events (a gap in a real trace is skipped), in order: by length as
-    given, then by start; and how many the cap left out.
+    """The distinct windows of every length in ``lengths`` (:func:`_windows`) over the
+    sorted event ``times`` that hold at least ``min_events`` events (a gap in a real trace
+    is skipped), in order: by length as given, then by start; and how many the cap left out.
 
     With more than ``cap`` distinct windows, each length keeps a share of its windows
     in proportion to their number, at least one (largest remainders, so the shares sum
@@ -691,14 +692,13 @@ def _scaled_windows(event_t: np.ndarray, lengths, step: float | None = None, cap
     from its first window to its last (one window: the middle one)."""
     seen: set = set()
     per_length = []
-    times = np.sort(event_t)
 
     def enough(span) -> bool:
         return span is None or (np.searchsorted(times, span[1], side="right")
                                 - np.searchsorted(times, span[0], side="left")) >= min_events
 
     for length in lengths:
-        spans = [span for span in _windows(event_t, length, step) if span not in seen and enough(span)]
+        spans = [span for span in _windows(times, length, step) if span not in seen and enough(span)]
         seen.update(spans)
         per_length.append(spans)
     sizes = np.array([len(spans) for spans in per_length])
@@ -733,10 +733,10 @@ def _evenly(n: int, k: int) -> np.ndarray:
     return np.unique(np.linspace(0, n - 1, k).round().astype(int))
 
 
-def _silence_warnings(event_t: np.ndarray, window_length: float) -> list[str]:
-    """A silence in the log longer than a window (a night in a multi-day trace): it
-    stretches the mean gap the automatic h, windows and diffusion time come from."""
-    times = np.sort(event_t)
+def _silence_warnings(times: np.ndarray, window_length: float) -> list[str]:
+    """A silence between the sorted event ``times`` longer than a window (a night in a
+    multi-day trace): it stretches the mean gap the automatic h, windows and diffusion
+    time come from."""
     gaps = np.diff(times)
     if not len(gaps) or not np.isfinite(window_length) or gaps.max() <= window_length:
         return []
