@@ -33,7 +33,8 @@ from swarmtopo.experiments.accuracy import (CELLS, PIPELINES, accuracy_table, be
 from swarmtopo.experiments.store import read_jobs
 from swarmtopo.experiments.sweep import map_input
 
-COLUMNS = ("key", "config", "replicate", "diagrams", "error", "est_betti0", "true_betti0", "true_betti1", "t_total")
+COLUMNS = ("key", "config", "replicate", "diagrams", "error", "est_betti0", "confidence_betti0", "true_betti0", "true_betti1",
+           "t_total")
 """The columns the verdict needs (``accuracy.outcomes``)."""
 
 

@@ -68,8 +68,7 @@ def main() -> None:
     selection = fit_and_select(examples["train"], examples["heldout"], provenance)
     selection.classifier.save(DATA / "classifier-paper-form.json")
 
-    paper = paper_classifier().calibrate(examples["heldout"].diagrams, examples["heldout"].truth,
-                                         beta0_correct=examples["heldout"].beta0_correct)
+    paper = paper_classifier().calibrate(examples["heldout"].diagrams, examples["heldout"].truth)
     paper.provenance_["calibration"] = "scripts/train_classifier.py: held-out maps of the default training"
     paper.save(DATA / "classifier-paper.json")
     paper_scores = detection_scores(paper.predict(examples["heldout"].diagrams), examples["heldout"].truth)
@@ -107,6 +106,7 @@ def write_doc(selection, paper_scores, examples, seconds, summary, job_seconds) 
                  f"{paper_scores.sensitivity:.3f} | {paper_scores.false_hole_rate:.3f} | {paper_scores.exact:.3f} |")
     calib = selection.classifier.calibration_
     heldout = examples["heldout"]
+    beta0_rate = (heldout.beta0_correct.sum() + 1) / (len(heldout.beta0_correct) + 2)
     model = selection.classifier
     confidence = np.array([model.confidence(d)[1] for d in heldout.diagrams])
     right = model.predict(heldout.diagrams) == heldout.truth
@@ -116,7 +116,7 @@ def write_doc(selection, paper_scores, examples, seconds, summary, job_seconds) 
         f"Confidence model of the kept classifier (held-out maps): P(beta_1 right) = "
         f"sigmoid({calib['1']['intercept']:.3f} + {calib['1']['margin']:.3f} m + {calib['1']['gap']:.3f} g), "
         "m the log-ratio margin of the nearest bar to the threshold, g the log-ratio gap between the shortest "
-        f"counted and the longest uncounted bar; beta_0 right in {calib['0']['rate']:.3f} of held-out maps "
+        f"counted and the longest uncounted bar; beta_0 right in {beta0_rate:.3f} of held-out maps "
         "(Laplace-smoothed).",
         "",
         f"On the held-out maps (the ones it was fitted on) the beta_1 confidence ranges "

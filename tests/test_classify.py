@@ -167,12 +167,11 @@ def test_over_counting_keeps_sensitivity_but_not_the_false_hole_rate():
 def test_confidence_grows_with_the_margin_and_stays_in_unit_interval():
     dgms, truth = synthetic_set(150, 8, signal_ratio=(1.5, 10.0))
     model = BettiClassifier().fit(dgms[:75], truth[:75])
-    model.calibrate(dgms[75:], truth[75:], beta0_correct=[True] * 9 + [False])
+    model.calibrate(dgms[75:], truth[75:])
     calib = model.calibration_["1"]
     assert calib["margin"] + calib["gap"] > 0        # clearer separation, more often right
     conf = np.array([model.confidence(d)[1] for d in dgms])
     assert ((conf > 0) & (conf < 1)).all()
-    assert model.beta0_confidence() == pytest.approx(10 / 12)  # (9 + 1) / (10 + 2)
 
 
 def test_confidence_features_hand_case():
@@ -190,7 +189,6 @@ def test_confidence_features_hand_case():
 def test_uncalibrated_classifier_reports_no_confidence():
     model = paper_classifier()
     assert model.confidence(diagram([5.0, 1.0, 1.0])) == {1: None}
-    assert model.beta0_confidence() is None
 
 
 # -- persistence -----------------------------------------------------------------------

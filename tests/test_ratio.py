@@ -173,12 +173,10 @@ def test_calibration_and_json_round_trip(tmp_path):
         bars = [[1, 21], [1, 2], [1, 2]] if clean else [[1, 3.05], [1, 2], [1, 2]]
         regions.append(windows_of(bars, bars, bars))
         correct.append(clean or rng.random() < 0.3)
-    model.calibrate([model.region_features(r, 1) for r in regions], correct,
-                    beta0_correct=[True] * 59 + [False])
+    model.calibrate([model.region_features(r, 1) for r in regions], correct)
     sure = model.region_confidence(windows_of(*[[[1, 21], [1, 2], [1, 2]]] * 3))[1]
     unsure = model.region_confidence(windows_of(*[[[1, 3.05], [1, 2], [1, 2]]] * 3))[1]
     assert 0 <= unsure < sure <= 1 and sure > 0.8 and unsure < 0.6
-    assert model.beta0_confidence() == pytest.approx(60 / 62)
     path = tmp_path / "c.json"
     model.save(path)
     again = load_classifier(path)
@@ -217,22 +215,31 @@ def test_bad_thresholds_and_files_are_input_errors():
 def test_shipped_default_is_a_calibrated_mean_pooled_ratio_classifier():
     model = load_classifier("default")
     assert isinstance(model, RatioClassifier) and model.pooling == "mean"
-    assert model.calibration_.get("1") and model.beta0_confidence() is not None
+    assert set(model.calibration_) == {"1"}  # beta_0's confidence is the pipeline's (swarmtopo.beta0)
 
 
 @pytest.mark.parametrize("key, value, message", [
-    ("rate", "high", "must be a finite number in \\[0, 1\\]"),
-    ("rate", 2.0, "must be a finite number in \\[0, 1\\]"),
-    ("rate", float("nan"), "must be a finite number in \\[0, 1\\]"),
+    ("z", "high", "must be a finite number"),
+    ("intercept", float("nan"), "must be a finite number"),
     ("maps", -1, "must be a finite number"),
 ])
 def test_a_classifier_file_with_a_bad_calibration_is_refused_naming_the_file(tmp_path, key, value, message):
     import json
 
     obj = json.loads(json.dumps(load_classifier("default").to_json()))
-    obj["calibration"]["0"][key] = value
+    obj["calibration"]["1"][key] = value
     path = tmp_path / "c.json"
     path.write_text(json.dumps(obj))
     with pytest.raises(InputError, match=message) as caught:
         load_classifier(path)
-    assert (caught.value.file, caught.value.column) == (str(path), f"calibration.0.{key}")
+    assert (caught.value.file, caught.value.column) == (str(path), f"calibration.1.{key}")
+
+
+def test_an_earlier_classifier_file_with_a_beta0_rate_still_loads(tmp_path):
+    import json
+
+    obj = json.loads(json.dumps(load_classifier("default").to_json()))
+    obj["calibration"]["0"] = {"maps": 1248, "rate": 0.9992}
+    path = tmp_path / "c.json"
+    path.write_text(json.dumps(obj))
+    assert load_classifier(path).calibration_ == load_classifier("default").calibration_

@@ -459,3 +459,14 @@ def test_sigkill_loses_no_written_row_and_a_rerun_finishes_exactly_the_rest(tmp_
 def test_sweep_help_shows_an_example():
     proc = run_cli("sweep", "--help")
     assert proc.returncode == 0 and "Example: swarmtopo sweep examples/sweep-small.toml" in proc.stdout
+
+
+def test_a_sweep_whose_every_job_fails_exits_1_with_its_rows_stored(tmp_path):
+    path = tmp_path / "lonely.toml"
+    path.write_text('[sweep]\nname = "lonely"\nreplicates = 2\n[swarm]\nagents = 1\nduration = 1\n')
+    proc = run_cli("sweep", path, "--store", tmp_path / "r.duckdb", "--workers", "1")
+    assert proc.returncode == 1 and "Traceback" not in proc.stderr
+    assert proc.stderr.strip().splitlines() == [
+        f"error: sweep 'lonely': all 2 jobs run failed (the log has 0 event(s); at least 2 encounters are needed "
+        f"to build a map); their rows are in {tmp_path / 'r.duckdb'}"]
+    assert [row["error"] is not None for row in read_jobs(tmp_path / "r.duckdb")] == [True, True]

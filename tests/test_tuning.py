@@ -66,7 +66,6 @@ def test_cross_fitted_calibration_is_confident_on_clean_maps():
     # every out-of-fold outcome is right: the smoothed rate (30 + 1) / (30 + 2)
     confidence = model.region_confidence(maps[0].regions[0])[1]
     assert np.isclose(confidence, 31 / 32)
-    assert np.isclose(model.beta0_confidence(), 31 / 32)
 
 
 def test_cross_validated_count_reads_every_map_once_with_out_of_fold_thresholds():

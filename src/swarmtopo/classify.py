@@ -32,9 +32,9 @@ m = min_i |ln(r^i / tau_n)|, how far the nearest bar sits from the threshold, an
 gap g = ln(r_above / r_below) between the shortest counted bar and the longest
 uncounted one, how cleanly the counted bars stand apart from the rest wherever tau
 falls.  :meth:`BettiClassifier.calibrate` fits P(beta_hat_n correct | m, g) by
-logistic regression on held-out maps; :meth:`BettiClassifier.confidence` returns it.  The
-confidence of beta_0 (counted from graph components by the pipeline, not by this
-classifier) is the held-out rate of correct beta_0, with Laplace's rule of succession.
+logistic regression on held-out maps; :meth:`BettiClassifier.confidence` returns it.
+beta_0 is counted from graph components by the pipeline, not by this classifier; its
+confidence is the pipeline's (:mod:`swarmtopo.beta0`).
 """
 
 from __future__ import annotations
@@ -197,11 +197,8 @@ class BettiClassifier(BaseEstimator):
         self.provenance_["training_maps"] = len(X)
         return self
 
-    def calibrate(self, X: Sequence[Diagram], y, beta0_correct=None) -> "BettiClassifier":
-        """Fit the confidence model on held-out maps (module docstring).
-
-        ``beta0_correct`` (booleans, one per held-out map) gives the beta_0 rate.
-        """
+    def calibrate(self, X: Sequence[Diagram], y) -> "BettiClassifier":
+        """Fit the confidence model on held-out maps (module docstring)."""
         self._check_fitted()
         truth = _truth_matrix(y, len(X), list(self.theta_))
         calibration: dict[str, Any] = {"maps": len(X)}
@@ -218,9 +215,6 @@ class BettiClassifier(BaseEstimator):
                 model = LogisticRegression(C=1.0).fit(features, correct)
                 calibration[str(n)] = {"intercept": float(model.intercept_[0]), "margin": float(model.coef_[0, 0]),
                                        "gap": float(model.coef_[0, 1]), "accuracy": float(correct.mean())}
-        if beta0_correct is not None:
-            ok = np.asarray(beta0_correct, dtype=bool)
-            calibration["0"] = {"rate": float((ok.sum() + 1) / (len(ok) + 2)), "maps": int(len(ok))}
         self.calibration_ = calibration
         return self
 
@@ -285,11 +279,6 @@ class BettiClassifier(BaseEstimator):
             out[n] = float(expit(model["intercept"] + model["margin"] * m + model["gap"] * g))
         return out
 
-    def beta0_confidence(self) -> float | None:
-        """Held-out rate of a correct beta_0 (Laplace-smoothed); None if uncalibrated."""
-        model = getattr(self, "calibration_", {}).get("0")
-        return None if model is None else float(model["rate"])
-
     def score(self, X: Sequence[Diagram], y) -> float:
         """-F(Theta*) averaged over dims (higher is better, scikit-learn convention)."""
         self._check_fitted()
@@ -306,7 +295,7 @@ class BettiClassifier(BaseEstimator):
                           "l_q = q-quantile of the dim-n bar lengths",
             "theta": {str(n): th.to_json() for n, th in self.theta_.items()},
             "confidence": "P(correct) from a logistic model of the log-ratio margin of the nearest bar to "
-                          "the threshold and the gap around it, fitted on held-out maps; beta_0: held-out rate",
+                          "the threshold and the gap around it, fitted on held-out maps",
         }
 
     # -- persistence -----------------------------------------------------------------
@@ -338,7 +327,8 @@ class BettiClassifier(BaseEstimator):
                 raise InputError(f"Theta_{n} out of range (need 0 <= q <= 1, Delta >= 0, tau > 0)",
                                  file=source, column=f"theta.{n}", value=th.to_json())
         if obj.get("calibration"):
-            model.calibration_ = obj["calibration"]
+            # "0": earlier files' beta_0 rate; beta_0's confidence is now the pipeline's (swarmtopo.beta0)
+            model.calibration_ = {n: c for n, c in obj["calibration"].items() if n != "0"}
         return model
 
     def save(self, path) -> None:

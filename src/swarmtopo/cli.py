@@ -440,6 +440,11 @@ def sweep(
             err.print(f"interrupted: finished jobs are saved in {store}; run the same command again to run the rest",
                       markup=False, highlight=False, soft_wrap=True)
         raise typer.Exit(130) from None
+    if summary.run and summary.failed == summary.run:  # no job mapped: the grid, not the data, is likely wrong
+        message = max(summary.errors.items(), key=lambda item: item[1])[0]
+        err.print(f"error: sweep {grid.name!r}: all {summary.run} jobs run failed ({message}); their rows are in "
+                  f"{store}", markup=False, highlight=False, soft_wrap=True)
+        raise typer.Exit(1)
     if quiet:
         return
     if summary.run == 0:

@@ -27,6 +27,7 @@ from typing import Any, Callable
 import numpy as np
 
 from . import __version__
+from .beta0 import BETA0_DEFINITION, Beta0Evidence, beta0_evidence, shipped_beta0_model
 from .classify import BettiClassifier, RegionScales, load_classifier
 from .cycles import Cycle, region_cycles
 from .embed import Embedding, mds
@@ -323,9 +324,10 @@ class TopologicalMap:
 
     ``betti[n]`` is the estimated n-th Betti number: beta_0 counts regions, beta_1
     holes (None for a dimension the classifier has no Theta_n for).
-    ``confidence[n]`` is the probability that ``betti[n]`` is right (see
-    :mod:`swarmtopo.classify`; beta_n for n >= 1 is a sum over regions, so its
-    confidence is the product of the regions'; None without a calibrated classifier).
+    ``confidence[n]`` is the probability that ``betti[n]`` is right: beta_0's from
+    :mod:`swarmtopo.beta0` (read from ``beta0_evidence``); beta_n for n >= 1 is a sum
+    over regions, so its confidence is the product of the regions' (see
+    :mod:`swarmtopo.ratio`; None without a calibrated classifier).
     ``diagram`` is the union of the regions' diagrams.
     """
 
@@ -345,6 +347,7 @@ class TopologicalMap:
     windows_left_out: int = 0  # windows the cap (MapConfig.max_windows) left unmapped
     software: dict[str, str] = field(default_factory=dict)
     log_warnings: list[str] = field(default_factory=list)  # about the mapped log as a whole
+    beta0_evidence: Beta0Evidence | None = None  # what beta_0's confidence was read from
 
     @property
     def warnings(self) -> list[str]:
@@ -357,6 +360,14 @@ class TopologicalMap:
         if not low:
             return []
         lines = [f"beta_{n} = {self.betti[n]} is uncertain ({100 * self.confidence[n]:.0f}% confidence)" for n in low]
+        evidence = self.beta0_evidence
+        if 0 in low and evidence is not None:
+            lines.append(
+                f"the {evidence.regions} regions have stayed apart for only {evidence.settled:.3g} mean gaps between an "
+                "agent's encounters since they formed; groups in one room merge when their agents meet, so only a "
+                "longer log tells one room from several" if evidence.regions >= 2 else
+                f"{100 * evidence.fragments:.0f}% of the events are in groups too small to map (too_little_data); "
+                "a room only a few agents saw would hide there")
         for r in self.regions:
             counts = [w.betti.get(1) for w in r.windows]
             if len(set(counts)) > 1:
@@ -365,8 +376,11 @@ class TopologicalMap:
         more_time = ("" if self.windows_left_out else
                      f"record longer (each extra {self.config.window_step or length / 2:.3g} s adds a window to "
                      "the pooling), " if np.isfinite(length) else "record longer, ")
-        lines.append(f"to raise it: {more_time}use more agents than {self.n_agents} (denser windows); "
-                     "'swarmtopo plan --area A --agents N --target 0.95' tells how much")
+        how_much = ("'swarmtopo plan --area A --agents N --target 0.95' tells how much"
+                    if self.classifier.get("classifier") != "trace" else
+                    "for a contact trace (no status changes), docs/accuracy.md 'Contact traces' gives the accuracy by "
+                    "swarm size and duration ('swarmtopo plan' answers for logs with status changes)")
+        lines.append(f"to raise it: {more_time}use more agents than {self.n_agents} (denser windows); {how_much}")
         return lines
 
     def to_json(self) -> dict[str, Any]:
@@ -399,6 +413,8 @@ class TopologicalMap:
                 for r in self.regions
             ],
             "too_little_data": self.too_little_data,
+            "beta0_evidence": None if self.beta0_evidence is None else {**self.beta0_evidence.to_json(),
+                                                                          "definition": BETA0_DEFINITION},
             "params": {**jsonable(asdict(self.config)), "hop_cost_used": self.hop_cost[0],
                        "hop_cost_source": self.hop_cost[1],
                        "diffusion_time_used": self.diffusion_time[0] if np.isfinite(self.diffusion_time[0]) else None,
@@ -409,6 +425,72 @@ class TopologicalMap:
             "timings": {k: round(v, 6) for k, v in self.timings.items()},
             "software": {**self.software, "persistence_backend": self.diagram.backend},
         }
+
+
+@dataclass(frozen=True)
+class RegionSplit:
+    """The mapped log's encounter graph cut into components, and which are regions
+    (module docstring): what ``map_encounters`` maps and what beta_0 counts."""
+
+    graph: EncounterGraph
+    labels: np.ndarray  # component of each graph node
+    event_comp: np.ndarray  # component of each mapped event
+    events_per_comp: np.ndarray
+    agents_per_comp: np.ndarray
+    regions: list[int]  # the components that count as regions, most events first
+    times: np.ndarray  # the mapped events' times, sorted
+    agent_gap: float | None  # mean time between an agent's consecutive encounters
+    hop_cost: tuple[float, str]  # (h, where it came from)
+    diffusion_time: tuple[float, str]  # (tau, where it came from)
+    beta0: Beta0Evidence
+
+
+def split_regions(log: EncounterLog, config: MapConfig) -> RegionSplit:
+    """Build the encounter graph of ``log`` (``config.window`` applied) and find its regions.
+
+    Raises
+    ------
+    SwarmtopoError
+        If there are fewer than 2 events, all at one instant, or no component is big
+        enough to count as a region.
+    """
+    if log.n_events < 2:
+        raise SwarmtopoError(
+            f"the log has {log.n_events} event(s); at least 2 encounters are needed to build a map")
+    mapped = log if config.window is None else log.window(*config.window)
+    hop_cost = resolve_hop_cost(mapped, config.hop_cost)
+    agent_gap = mean_agent_gap(mapped)
+    diffusion_time = resolve_diffusion_time(agent_gap, config.diffusion_time)
+    graph = build_graph(log, config.metric, window=config.window, hop_cost=hop_cost[0],
+                        diffusion_time=diffusion_time[0], wall_follow_weight=config.wall_follow_weight)
+    n_comp, labels = graph.components()
+    event_comp = labels[graph.node_of_event]
+    events_per_comp = np.bincount(event_comp, minlength=n_comp)
+    agents_per_comp = _agents_per_component(log, graph.event_index, event_comp, n_comp)
+
+    times = np.sort(graph.event_t)  # the mapped events' times, for the span, the windows and the silences
+    if graph.n_events >= 2 and times[0] == times[-1]:
+        raise SwarmtopoError(f"all {graph.n_events} encounters are at one time (t = {exact_time(times[0])} s); "
+                             f"a map needs encounters spread over time")
+    is_region = ((events_per_comp >= config.min_region_events) & (agents_per_comp >= MIN_REGION_AGENTS)
+                 & (np.bincount(labels, minlength=n_comp) >= 2))  # one node: its encounters all at one instant
+    regions = [int(c) for c in np.argsort(-events_per_comp, kind="stable") if is_region[c]]
+    if not regions:
+        largest = int(np.argmax(events_per_comp))
+        raise SwarmtopoError(
+            f"no connected group of encounters has {config.min_region_events} events or more among "
+            f"{MIN_REGION_AGENTS} agents or more (largest: {int(events_per_comp[largest])} events among "
+            f"{int(agents_per_comp[largest])} agents, of {graph.n_events} events in {n_comp} groups); "
+            f"the log is too short or the agents too few to map: collect more data")
+    a, b = log.a[graph.event_index], log.b[graph.event_index]
+    region_of_comp = np.full(n_comp, -1)
+    region_of_comp[regions] = np.arange(len(regions))
+    region_of_agent = np.full(log.n_agents, -1)
+    region_of_agent[a] = region_of_agent[b] = region_of_comp[event_comp]  # an agent's events share a component
+    evidence = beta0_evidence(a, b, graph.event_t, region_of_agent, len(regions),
+                              int(events_per_comp[regions].sum()), agent_gap)
+    return RegionSplit(graph, labels, event_comp, events_per_comp, agents_per_comp, regions, times, agent_gap,
+                       hop_cost, diffusion_time, evidence)
 
 
 def map_encounters(
@@ -443,38 +525,15 @@ def map_encounters(
     rng = np.random.default_rng(config.seed)
     say = progress or (lambda stage: None)
     timings = dict.fromkeys(STAGES, 0.0)
-
-    if log.n_events < 2:
-        raise SwarmtopoError(
-            f"the log has {log.n_events} event(s); at least 2 encounters are needed to build a map")
     say("graph")
     t0 = time.perf_counter()
-    mapped = log if config.window is None else log.window(*config.window)
-    hop_cost, hop_source = resolve_hop_cost(mapped, config.hop_cost)
-    agent_gap = mean_agent_gap(mapped)
-    diffusion_time, diffusion_source = resolve_diffusion_time(agent_gap, config.diffusion_time)
-    graph = build_graph(log, config.metric, window=config.window, hop_cost=hop_cost, diffusion_time=diffusion_time,
-                        wall_follow_weight=config.wall_follow_weight)
-    n_comp, labels = graph.components()
-    event_comp = labels[graph.node_of_event]
-    events_per_comp = np.bincount(event_comp, minlength=n_comp)
-    agents_per_comp = _agents_per_component(log, graph.event_index, event_comp, n_comp)
+    split = split_regions(log, config)
+    graph, labels, event_comp = split.graph, split.labels, split.event_comp
+    events_per_comp, agents_per_comp, regions_idx = split.events_per_comp, split.agents_per_comp, split.regions
+    hop_cost, hop_source = split.hop_cost
+    diffusion_time, diffusion_source = split.diffusion_time
+    agent_gap, times = split.agent_gap, split.times
     timings["graph"] = time.perf_counter() - t0
-
-    times = np.sort(graph.event_t)  # the mapped events' times, for the span, the windows and the silences
-    if graph.n_events >= 2 and times[0] == times[-1]:
-        raise SwarmtopoError(f"all {graph.n_events} encounters are at one time (t = {exact_time(times[0])} s); "
-                             f"a map needs encounters spread over time")
-    is_region = ((events_per_comp >= config.min_region_events) & (agents_per_comp >= MIN_REGION_AGENTS)
-                 & (np.bincount(labels, minlength=n_comp) >= 2))  # one node: its encounters all at one instant
-    regions_idx = [int(c) for c in np.argsort(-events_per_comp, kind="stable") if is_region[c]]
-    if not regions_idx:
-        largest = int(np.argmax(events_per_comp))
-        raise SwarmtopoError(
-            f"no connected group of encounters has {config.min_region_events} events or more among "
-            f"{MIN_REGION_AGENTS} agents or more (largest: {int(events_per_comp[largest])} events among "
-            f"{int(agents_per_comp[largest])} agents, of {graph.n_events} events in {n_comp} groups); "
-            f"the log is too short or the agents too few to map: collect more data")
 
     shares = (_share_landmarks(config.landmarks, events_per_comp[regions_idx]) if config.landmarks
               else [None] * len(regions_idx))
@@ -554,14 +613,14 @@ def map_encounters(
             regions[-1].cycles = region_cycles(regions[-1], chosen.persistence)
             timings["cycles"] += time.perf_counter() - t0
     betti: dict[int, int | None] = {0: len(regions)}
-    confidence: dict[int, float | None] = {0: classifier.beta0_confidence()}
+    confidence: dict[int, float | None] = {0: shipped_beta0_model().confidence(split.beta0)}
     for n in range(1, config.maxdim + 1):
         known = all(n in r.betti for r in regions)
         betti[n] = sum(r.betti[n] for r in regions) if known else None
         region_conf = [r.confidence.get(n) for r in regions]
         confidence[n] = (float(np.prod(region_conf)) if known and None not in region_conf else None)
     too_little = [{"component": int(c), "events": int(events_per_comp[c]), "agents": int(agents_per_comp[c])}
-                  for c in range(n_comp) if not is_region[c]]
+                  for c in range(len(events_per_comp)) if c not in regions_idx]
     return TopologicalMap(
         betti=betti,
         confidence=confidence,
@@ -580,6 +639,7 @@ def map_encounters(
         window_length=(window_length, window_source),
         windows_left_out=left_out,
         log_warnings=_silence_warnings(times, window_length),
+        beta0_evidence=split.beta0,
         software=software_versions(),
     )
 

@@ -221,8 +221,8 @@ class RatioClassifier:
         ``{n: RatioThresholds(q_n, tau_n)}`` for each homology dimension n >= 1.
     calibration
         Per dimension the logistic P(correct): ``{"intercept", "z"}`` (older files:
-        ``"agreement", "margin", "windows"``; :meth:`region_features`), and
-        ``"0": {"rate": ...}`` for beta_0; None = uncalibrated.
+        ``"agreement", "margin", "windows"``; :meth:`region_features`); None =
+        uncalibrated.  (beta_0's confidence is the pipeline's: :mod:`swarmtopo.beta0`.)
     provenance
         Free-form record of how it was fitted (name, data, script).
     pooling
@@ -240,15 +240,14 @@ class RatioClassifier:
             raise InputError(f"unknown pooling; expected one of {', '.join(POOLINGS)}", column="pooling",
                              value=pooling)
         for n, model in (calibration or {}).items():
-            unknown = set(model) - {"intercept", "maps", "rate", *REGION_FEATURES}
+            unknown = set(model) - {"intercept", "maps", *REGION_FEATURES}
             if unknown:
                 raise InputError(f"unknown confidence feature(s) {sorted(unknown)}; known: "
                                  f"{', '.join(REGION_FEATURES)}", column=f"calibration.{n}", value=model)
             for key, value in model.items():
                 if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or (
-                        key == "rate" and not 0.0 <= value <= 1.0) or (key == "maps" and value < 0):
-                    raise InputError("must be a finite number" + (" in [0, 1]" if key == "rate" else ""),
-                                     column=f"calibration.{n}.{key}", value=value)
+                        key == "maps" and value < 0):
+                    raise InputError("must be a finite number", column=f"calibration.{n}.{key}", value=value)
         self.thresholds_ = {int(n): th for n, th in sorted(thresholds.items())}
         self.calibration_ = dict(calibration or {})
         self.provenance_ = dict(provenance or {})
@@ -312,18 +311,13 @@ class RatioClassifier:
                                                           if name in features)))
         return out
 
-    def beta0_confidence(self) -> float | None:
-        """Tuning-set rate of a correct beta_0 (Laplace-smoothed); None if uncalibrated."""
-        model = self.calibration_.get("0")
-        return None if model is None else float(model["rate"])
-
     # -- fitting -------------------------------------------------------------------------
-    def calibrate(self, features: Sequence[dict[str, float]], correct, beta0_correct=None) -> "RatioClassifier":
+    def calibrate(self, features: Sequence[dict[str, float]], correct) -> "RatioClassifier":
         """Fit P(correct | CONFIDENCE_FEATURES) for dimension 1.
 
         ``features[k]`` are region k's (:meth:`region_features`, of this or of another
         classifier when the outcomes are cross-fitted) and ``correct[k]`` whether its
-        vote was right; ``beta0_correct`` (one bool per map) gives the beta_0 rate.
+        vote was right.
         """
         X = confidence_design(features)
         y = np.asarray(correct, dtype=bool)
@@ -333,13 +327,8 @@ class RatioClassifier:
         else:  # all right (or all wrong): the smoothed rate, whatever the features
             rate = (y.sum() + 1) / (len(y) + 2)
             intercept, coefficients = float(np.log(rate / (1 - rate))), np.zeros(len(CONFIDENCE_FEATURES))
-        calibration: dict[str, Any] = {"1": {"intercept": intercept, **dict(zip(CONFIDENCE_FEATURES,
-                                                                                 map(float, coefficients))),
-                                             "maps": int(len(y))}}
-        if beta0_correct is not None:
-            ok = np.asarray(beta0_correct, dtype=bool)
-            calibration["0"] = {"rate": float((ok.sum() + 1) / (len(ok) + 2)), "maps": int(len(ok))}
-        self.calibration_ = calibration
+        self.calibration_ = {"1": {"intercept": intercept, **dict(zip(CONFIDENCE_FEATURES, map(float, coefficients))),
+                                   "maps": int(len(y))}}
         return self
 
     # -- description and files ------------------------------------------------------------
@@ -364,9 +353,9 @@ class RatioClassifier:
             return "uncalibrated"
         if "z" in model:
             return ("P(correct) from a logistic model of z, how many standard errors (over the windows) the pooled "
-                    "scores are from changing the vote, fitted on the benchmark's tuning maps; beta_0: tuning-set rate")
+                    "scores are from changing the vote, fitted on the benchmark's tuning maps")
         return ("P(correct) from a logistic model of the windows' agreement with the vote, the vote's log margin and "
-                "the number of windows, fitted on the benchmark's tuning maps; beta_0: tuning-set rate")
+                "the number of windows, fitted on the benchmark's tuning maps")
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -397,7 +386,9 @@ class RatioClassifier:
                                      value=gates)
                 thresholds[int(n)] = RatioThresholds(float(t["q"]), float(t["tau"]))
             pooling = obj.get("pooling", "mean") if obj["format"] == RATIO_FORMAT else "median"
-            return cls(thresholds, obj.get("calibration") or None, obj.get("provenance") or {}, pooling)
+            # "0": earlier files' beta_0 rate; beta_0's confidence is now the pipeline's (swarmtopo.beta0)
+            calibration = {n: c for n, c in (obj.get("calibration") or {}).items() if n != "0"}
+            return cls(thresholds, calibration or None, obj.get("provenance") or {}, pooling)
         except InputError as exc:
             if exc.file is not None:
                 raise

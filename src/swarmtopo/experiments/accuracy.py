@@ -223,7 +223,8 @@ def outcomes(rows, classifier) -> list[dict[str, Any]]:
     beta_1 and its confidence are read from the row's stored per-window diagrams by
     ``classifier`` (each region's windows voted as in the pipeline), so the table is
     the given classifier's verdict on the stored maps: the shipped one's, whatever
-    classifier ran the job.  beta_0 is the job's (graph components).  A failed job
+    classifier ran the job.  beta_0 and its confidence are the job's (graph components,
+    :mod:`swarmtopo.beta0`).  A failed job
     (too little data to map) counts as wrong.
     """
     records = []
@@ -236,7 +237,7 @@ def outcomes(rows, classifier) -> list[dict[str, Any]]:
             est1 = sum(voted[0].get(1, 0) for voted in votes)
             confs = [classifier.region_confidence(windows, voted).get(1) for windows, voted in zip(regions, votes)]
             conf1 = None if None in confs else float(np.prod(confs))
-            conf0 = classifier.beta0_confidence()
+            conf0 = row["confidence_betti0"]
         right = row["error"] is None and est0 == row["true_betti0"] and est1 == row["true_betti1"]
         records.append({
             "cell": cell_of(config), "index": row["replicate"], "held_out": has_held_out_family(config),

@@ -111,6 +111,6 @@ def fit_and_select(train: Examples, heldout: Examples, provenance: dict[str, Any
         fits[optimizer] = model.fit(train.diagrams, train.truth, provenance=provenance)
         scores[optimizer] = detection_scores(model.predict(heldout.diagrams), heldout.truth)
     winner = min(fits, key=lambda name: (scores[name].mean_absolute_error, name != "grid"))
-    fits[winner].calibrate(heldout.diagrams, heldout.truth, beta0_correct=heldout.beta0_correct)
+    fits[winner].calibrate(heldout.diagrams, heldout.truth)
     fits[winner].provenance_["heldout_F"] = scores[winner].mean_absolute_error
     return Selection(fits=fits, heldout_scores=scores, winner=winner)

@@ -160,9 +160,8 @@ def calibrated_classifier(maps: Sequence[TuningMap], fit: Fit, provenance: dict,
     The thresholds were chosen on these very maps, so their outcomes under them are
     optimistic.  The logistic model is fitted on out-of-fold features and outcomes
     (:func:`cross_fitted_features`) and then used with the final thresholds;
-    beta_0's rate uses all maps.
     """
     features, correct = cross_fitted_features(maps, fit.pooling, folds)
     model = RatioClassifier({1: fit.thresholds}, provenance={**provenance, "calibration": f"{folds}-fold cross-fitted"},
                             pooling=fit.pooling)
-    return model.calibrate(features, correct, beta0_correct=[m.est_betti0 == m.true_betti0 for m in maps])
+    return model.calibrate(features, correct)
