@@ -7,6 +7,7 @@ import pytest
 
 from swarmtopo.arena import square_arena, two_rooms_arena
 from swarmtopo.beta0 import FORMED_SHARE, Beta0Evidence, Beta0Model, beta0_evidence, formation_times, shipped_beta0_model
+from swarmtopo.classify import load_classifier
 from swarmtopo.errors import InputError
 from swarmtopo.experiments.sweep import contact_trace
 from swarmtopo.pipeline import MapConfig, map_encounters, split_regions
@@ -25,14 +26,14 @@ def literal_formation_times(a, b, t, region_of_agent, n_regions, share=FORMED_SH
         return x
 
     size = np.bincount(region_of_agent[region_of_agent >= 0], minlength=n_regions)
-    formed = [t.min() if np.ceil(share * s - 1e-9) <= 1 else None for s in size]
+    formed = [None] * n_regions
     for k in np.argsort(t, kind="stable"):
         ra, rb = root(a[k]), root(b[k])
         if ra != rb:
             parent[ra] = rb
         region = region_of_agent[a[k]]
         group = sum(root(x) == root(a[k]) for x in range(len(parent)))
-        if region >= 0 and formed[region] is None and group >= np.ceil(share * size[region] - 1e-9):
+        if region >= 0 and formed[region] is None and group >= max(np.ceil(share * size[region] - 1e-9), 2):
             formed[region] = t[k]
     return np.array([np.nan if f is None else f for f in formed], dtype=float)
 
@@ -95,6 +96,9 @@ def test_a_bad_model_file_is_refused_naming_the_field(part, key, value):
     with pytest.raises(InputError, match="finite number") as caught:
         Beta0Model.from_json(obj, source="m.json")
     assert (caught.value.file, caught.value.column) == ("m.json", f"{part}.{key}")
+    with pytest.raises(InputError, match="must be an object") as caught:
+        Beta0Model.from_json({**shipped_beta0_model().to_json(), "provenance": "fitted"}, source="m.json")
+    assert caught.value.column == "provenance"
     with pytest.raises(InputError, match="beta_0 confidence model"):
         Beta0Model.from_json({"format": "swarmtopo-ratio-classifier/3"}, source="m.json")
 
@@ -120,6 +124,9 @@ def test_a_room_cut_before_its_agents_met_is_not_reported_as_several_rooms_with_
     assert trace.classifier["classifier"] == "trace" and trace.confidence[0] == tmap.confidence[0]
     assert not any("swarmtopo plan --area" in line for line in trace.advice())
     assert any("'Contact traces'" in line for line in trace.advice())
+    # it is the log that is a trace, whichever classifier reads it
+    read_as_paper = map_encounters(contact_trace(log), MapConfig(**FAST), classifier=load_classifier("paper"))
+    assert any("'Contact traces'" in line for line in read_as_paper.advice())
     # the same room recorded for 20 s: one region, and sure of it
     whole = map_encounters(simulate(square_arena(), 300, 20.0, rng=1).log, MapConfig(**FAST))
     assert whole.betti[0] == 1 and whole.confidence[0] > 0.95

@@ -62,33 +62,43 @@ class Beta0Evidence:
 def formation_times(a: np.ndarray, b: np.ndarray, t: np.ndarray, region_of_agent: np.ndarray,
                     n_regions: int, share: float = FORMED_SHARE) -> np.ndarray:
     """When each region formed: the time of the encounter after which one group of its
-    agents, linked by the encounters up to then, first held ``share`` of them.
+    agents, linked by the encounters up to then, first held ``share`` of them (and at
+    least two: a group forms at an encounter).
 
     ``a, b, t``: the mapped encounters; ``region_of_agent[i]`` is agent i's region
-    (-1: none).  Groups grow as in union-find over the encounters in time order; only
-    each pair's first encounter can join two groups, and of those the minimum spanning
-    forest of the agents (weights: first-encounter times) joins them in the same order,
-    so at most one merge per agent is replayed.
+    (-1: none; both agents of an encounter are in the same one).  Groups grow as in
+    union-find over the encounters in time order; only each pair's first encounter can
+    join two groups, and of those the minimum spanning forest of the agents (weights:
+    first-encounter times) joins them in the same order, so at most one merge per agent
+    is replayed, and only the regions' agents are numbered.
     """
-    n_agents = len(region_of_agent)
-    size = np.bincount(region_of_agent[region_of_agent >= 0], minlength=n_regions)
-    target = np.maximum(np.ceil(share * size - 1e-9), 1)
     formed = np.full(n_regions, np.nan)
-    formed[target <= 1] = t.min() if len(t) else np.nan  # one agent is a group from the start
-    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    inside = region_of_agent[a] >= 0
+    if not inside.any():
+        return formed
+    agents, ends = np.unique(np.r_[a[inside], b[inside]], return_inverse=True)
+    lo, hi = np.minimum(*ends.reshape(2, -1)), np.maximum(*ends.reshape(2, -1))
+    t = t[inside]
+    region = region_of_agent[agents]
+    target = np.maximum(np.ceil(share * np.bincount(region, minlength=n_regions) - 1e-9), 2)
     order = np.lexsort((t, lo, hi))
-    pair = lo[order] * np.int64(n_agents) + hi[order]
-    first = order[np.r_[True, pair[1:] != pair[:-1]]] if len(order) else order
+    pair = lo[order] * np.int64(len(agents)) + hi[order]
+    first = order[np.r_[True, pair[1:] != pair[:-1]]]
     instants, rank = np.unique(t[first], return_inverse=True)
     weights = rank + 1.0  # ranks of the times: exact, and never the zero the spanning forest ignores
-    forest = minimum_spanning_tree(coo_matrix((weights, (lo[first], hi[first])), shape=(n_agents, n_agents))).tocoo()
-    groups = DisjointSet(range(n_agents))
+    forest = minimum_spanning_tree(coo_matrix((weights, (lo[first], hi[first])),
+                                              shape=(len(agents), len(agents)))).tocoo()
+    groups = DisjointSet(range(len(agents)))
+    waiting = n_regions
     for k in np.argsort(forest.data, kind="stable"):
-        u, v = int(forest.row[k]), int(forest.col[k])
-        groups.merge(u, v)
-        region = region_of_agent[u]
-        if region >= 0 and np.isnan(formed[region]) and groups.subset_size(u) >= target[region]:
-            formed[region] = instants[int(forest.data[k]) - 1]
+        u = int(forest.row[k])
+        groups.merge(u, int(forest.col[k]))
+        r = region[u]
+        if np.isnan(formed[r]) and groups.subset_size(u) >= target[r]:
+            formed[r] = instants[int(forest.data[k]) - 1]
+            waiting -= 1
+            if not waiting:
+                break
     return formed
 
 
@@ -143,7 +153,10 @@ class Beta0Model:
                 if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
                     raise InputError("must be a finite number", file=source, column=f"{part}.{key}", value=value)
             pairs[part] = (float(model["intercept"]), float(model[slope]))
-        return cls(pairs["one"], pairs["several"], dict(obj.get("provenance") or {}))
+        provenance = obj.get("provenance") or {}
+        if not isinstance(provenance, dict):
+            raise InputError("must be an object", file=source, column="provenance", value=provenance)
+        return cls(pairs["one"], pairs["several"], dict(provenance))
 
 
 @lru_cache(maxsize=1)

@@ -348,6 +348,7 @@ class TopologicalMap:
     software: dict[str, str] = field(default_factory=dict)
     log_warnings: list[str] = field(default_factory=list)  # about the mapped log as a whole
     beta0_evidence: Beta0Evidence | None = None  # what beta_0's confidence was read from
+    contact_trace: bool = False  # the log has no status changes (plan's table does not cover it)
 
     @property
     def warnings(self) -> list[str]:
@@ -362,9 +363,10 @@ class TopologicalMap:
         lines = [f"beta_{n} = {self.betti[n]} is uncertain ({100 * self.confidence[n]:.0f}% confidence)" for n in low]
         evidence = self.beta0_evidence
         if 0 in low and evidence is not None:
+            apart = (f"have stayed apart for only {evidence.settled:.3g} mean gaps between an agent's encounters since "
+                     "they formed" if evidence.settled else "formed at the log's end (or no agent met twice)")
             lines.append(
-                f"the {evidence.regions} regions have stayed apart for only {evidence.settled:.3g} mean gaps between an "
-                "agent's encounters since they formed; groups in one room merge when their agents meet, so only a "
+                f"the {evidence.regions} regions {apart}; groups in one room merge when their agents meet, so only a "
                 "longer log tells one room from several" if evidence.regions >= 2 else
                 f"{100 * evidence.fragments:.0f}% of the events are in groups too small to map (too_little_data); "
                 "a room only a few agents saw would hide there")
@@ -377,7 +379,7 @@ class TopologicalMap:
                      f"record longer (each extra {self.config.window_step or length / 2:.3g} s adds a window to "
                      "the pooling), " if np.isfinite(length) else "record longer, ")
         how_much = ("'swarmtopo plan --area A --agents N --target 0.95' tells how much"
-                    if self.classifier.get("classifier") != "trace" else
+                    if not self.contact_trace else
                     "for a contact trace (no status changes), docs/accuracy.md 'Contact traces' gives the accuracy by "
                     "swarm size and duration ('swarmtopo plan' answers for logs with status changes)")
         lines.append(f"to raise it: {more_time}use more agents than {self.n_agents} (denser windows); {how_much}")
@@ -522,6 +524,7 @@ def map_encounters(
     """
     config = (config or MapConfig()).validate()
     classifier = classifier or load_classifier(shipped_classifier_for(log))
+    beta0_model = shipped_beta0_model()
     rng = np.random.default_rng(config.seed)
     say = progress or (lambda stage: None)
     timings = dict.fromkeys(STAGES, 0.0)
@@ -613,14 +616,14 @@ def map_encounters(
             regions[-1].cycles = region_cycles(regions[-1], chosen.persistence)
             timings["cycles"] += time.perf_counter() - t0
     betti: dict[int, int | None] = {0: len(regions)}
-    confidence: dict[int, float | None] = {0: shipped_beta0_model().confidence(split.beta0)}
+    confidence: dict[int, float | None] = {0: beta0_model.confidence(split.beta0)}
     for n in range(1, config.maxdim + 1):
         known = all(n in r.betti for r in regions)
         betti[n] = sum(r.betti[n] for r in regions) if known else None
         region_conf = [r.confidence.get(n) for r in regions]
         confidence[n] = (float(np.prod(region_conf)) if known and None not in region_conf else None)
     too_little = [{"component": int(c), "events": int(events_per_comp[c]), "agents": int(agents_per_comp[c])}
-                  for c in range(len(events_per_comp)) if c not in regions_idx]
+                  for c in np.setdiff1d(np.arange(len(events_per_comp)), regions_idx)]
     return TopologicalMap(
         betti=betti,
         confidence=confidence,
@@ -640,6 +643,7 @@ def map_encounters(
         windows_left_out=left_out,
         log_warnings=_silence_warnings(times, window_length),
         beta0_evidence=split.beta0,
+        contact_trace=shipped_classifier_for(log) == "trace",
         software=software_versions(),
     )
 
