@@ -472,3 +472,25 @@ def test_a_silence_longer_than_a_window_is_a_warning_and_a_day_mapped_alone_has_
     assert whole.to_json()["warnings"][0] == whole.warnings[0]
     day = map_encounters(log, MapConfig(window=(0.0, 100.0), **FAST))
     assert not any("silent" in w for w in day.warnings)
+
+
+def test_landmarks_below_the_sampling_guarantee_warn_and_give_no_beta1_confidence():
+    log = simulate(default_arena(), 200, 20.0, rng=3).log
+    sparse = map_encounters(log, MapConfig(landmarks=3, **FAST))
+    assert any(w.startswith("landmarks too sparse: 3 landmarks") for w in sparse.warnings)
+    # the confidence was calibrated with the automatic count: no number rather than a wrong one
+    assert sparse.confidence[1] is None and sparse.regions[0].confidence[1] is None
+    assert 0 < sparse.confidence[0] <= 1
+    automatic = map_encounters(log, MapConfig(**FAST))
+    assert not any("too sparse" in w for w in automatic.warnings) and automatic.confidence[1] is not None
+
+
+def test_a_hole_count_beyond_the_calibrated_arenas_is_flagged():
+    from swarmtopo.experiments.accuracy import CELLS
+    from swarmtopo.pipeline import CALIBRATED_HOLES, _extrapolation_warnings
+
+    assert CALIBRATED_HOLES == max(c.holes for c in CELLS if c.holes is not None)
+    assert _extrapolation_warnings({0: 1, 1: CALIBRATED_HOLES}) == []
+    assert _extrapolation_warnings({0: 1, 1: None}) == []
+    (line,) = _extrapolation_warnings({0: 1, 1: CALIBRATED_HOLES + 5})
+    assert line.startswith(f"beta_1 = {CALIBRATED_HOLES + 5} is beyond the 0-{CALIBRATED_HOLES} holes")

@@ -55,6 +55,9 @@ whole cloud's, so subsampling moves no bar by more than 3 s: the order of the
 cloud's own Rips noise bars."""
 ADVICE_BELOW = 0.9
 """A Betti number reported with less confidence than this comes with advice."""
+CALIBRATED_HOLES = 3
+"""The most holes of any arena the confidence was calibrated on (the accuracy
+benchmark's cells: 0-3); a map counting more says its confidence is extrapolated."""
 HOP_GAP_FACTOR = 2.0
 """Without r_d and v_c in meta.json, the per-hop cost h is this many times the mean time
 between an agent's consecutive encounters (docs/accuracy.md, "Real traces")."""
@@ -581,6 +584,9 @@ def map_encounters(
             w.betti = dict(zip(counts, window_counts))
         chosen = windows[rep]
         confidence_region = classifier.region_confidence(diagrams, voted)
+        sampling = _sampling_warnings(chosen.scales, len(chosen.landmarks.nodes), config)
+        if sampling:  # calibrated with the automatic landmark count only: no number to give
+            confidence_region = dict.fromkeys(confidence_region)
         counted = {n: longest_bars(chosen.diagram, n, count) for n, count in betti_region.items()}
         thresholds = classifier.length_thresholds(chosen.diagram)
         timings["classify"] += time.perf_counter() - t0
@@ -602,7 +608,7 @@ def map_encounters(
             betti=betti_region,
             confidence=confidence_region,
             cycles=[],
-            warnings=fallback + _sampling_warnings(chosen.scales, len(chosen.landmarks.nodes), config),
+            warnings=fallback + sampling,
             embedding=emb,
             windows=windows,
             window=rep,
@@ -641,7 +647,7 @@ def map_encounters(
         diffusion_time=(diffusion_time, diffusion_source),
         window_length=(window_length, window_source),
         windows_left_out=left_out,
-        log_warnings=_silence_warnings(times, window_length),
+        log_warnings=_silence_warnings(times, window_length) + _extrapolation_warnings(betti),
         beta0_evidence=split.beta0,
         contact_trace=shipped_classifier_for(log) == "trace",
         software=software_versions(),
@@ -859,6 +865,15 @@ def _knn_scale(graph: EncounterGraph, k: int) -> float:
     return float(np.median(knn_distances(distinct, k).mean(axis=1)))
 
 
+def _extrapolation_warnings(betti: dict[int, int | None]) -> list[str]:
+    """A hole count beyond the arenas the confidence was calibrated on."""
+    if (betti.get(1) or 0) > CALIBRATED_HOLES:
+        return [f"beta_1 = {betti[1]} is beyond the 0-{CALIBRATED_HOLES} holes of the arenas its confidence was "
+                "calibrated on (docs/accuracy.md): the confidence is extrapolated, and many holes in one arena "
+                "leave narrow passages between them, where holes merge or go unseen"]
+    return []
+
+
 def _sampling_warnings(scales: RegionScales, n_landmarks: int, config: MapConfig) -> list[str]:
     """Why a region's answer may be unreliable (empty when it is not).
 
@@ -869,7 +884,8 @@ def _sampling_warnings(scales: RegionScales, n_landmarks: int, config: MapConfig
     if config.landmarks and scales.cover_radius > AUTO_COVER_FACTOR * scales.knn:
         return [f"landmarks too sparse: {n_landmarks} landmarks leave a covering radius of "
                 f"{scales.cover_radius:.3g} s, over {AUTO_COVER_FACTOR:g} x the cloud's k-NN scale "
-                f"{scales.knn:.3g} s, so subsampling noise can pass the threshold; use more landmarks"]
+                f"{scales.knn:.3g} s, so subsampling noise can pass the threshold; use more landmarks (no beta_1 "
+                "confidence is given: it was calibrated with the automatic landmark count)"]
     return []
 
 
