@@ -133,6 +133,9 @@ def test_vote_picks_the_agreeing_window_with_the_largest_margin():
                    [[0, 2.5], [0, 1], [0, 1]])                    # 1, ratio 2.5 close to 2
     betti, rep, counts = vote(model, w)
     assert counts == {1: [2, 1, 1]} and betti == {1: 1} and rep == 1
+    # the widest margin in a window of under half the events of the fullest agreeing one: not shown
+    assert vote(model, w, events=[5000, 146, 4000]) == (betti, 2, counts)
+    assert vote(model, w, events=[5000, 2000, 4000])[1] == 1
 
 
 def test_vote_without_windows_is_an_error():

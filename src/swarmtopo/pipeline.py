@@ -578,7 +578,7 @@ def map_encounters(
         say("classify")
         t0 = time.perf_counter()
         diagrams = [w.diagram for w in windows]
-        voted = vote(classifier, diagrams)
+        voted = vote(classifier, diagrams, [w.n_events for w in windows])
         betti_region, rep, counts = voted
         for w, *window_counts in zip(windows, *counts.values()):
             w.betti = dict(zip(counts, window_counts))

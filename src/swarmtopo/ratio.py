@@ -188,14 +188,17 @@ def median_vote(counts: Sequence[int]) -> int:
     return ordered[(len(ordered) - 1) // 2]
 
 
-def vote(classifier, windows: Sequence[Diagram]) -> tuple[dict[int, int], int, dict[int, list[int]]]:
+def vote(classifier, windows: Sequence[Diagram], events: Sequence[int] | None = None
+         ) -> tuple[dict[int, int], int, dict[int, list[int]]]:
     """A region's beta_hat from its windows' diagrams: (vote, representative window, counts per window).
 
     ``classifier`` is a :class:`RatioClassifier` (pooled as its ``pooling`` says) or the
     paper-form :class:`~swarmtopo.classify.BettiClassifier` (the lower median of the
     windows' counts): its ``pooled_betti``.  The representative window is, among those
     whose own count equals the vote in the lowest dimension (or, if none does, is
-    nearest it), the one whose nearest bar is farthest from the threshold (the first on
+    nearest it) and that hold at least half the ``events`` of the fullest of them (all
+    of them without ``events``: a near-empty window of a bursty trace is no picture of
+    the region), the one whose nearest bar is farthest from the threshold (the first on
     ties).
     """
     if not windows:
@@ -208,6 +211,8 @@ def vote(classifier, windows: Sequence[Diagram]) -> tuple[dict[int, int], int, d
     key = min(counts)
     off = [abs(c - betti[key]) for c in counts[key]]
     nearest = [i for i, x in enumerate(off) if x == min(off)]
+    if events is not None:
+        nearest = [i for i in nearest if 2 * events[i] >= max(events[j] for j in nearest)]
     margins = [classifier.margin(windows[i], key) for i in nearest]
     return betti, nearest[int(np.argmax(margins))], counts
 
