@@ -466,7 +466,10 @@ def test_a_sweep_whose_every_job_fails_exits_1_with_its_rows_stored(tmp_path):
     path.write_text('[sweep]\nname = "lonely"\nreplicates = 2\n[swarm]\nagents = 1\nduration = 1\n')
     proc = run_cli("sweep", path, "--store", tmp_path / "r.duckdb", "--workers", "1")
     assert proc.returncode == 1 and "Traceback" not in proc.stderr
-    assert proc.stderr.strip().splitlines() == [
-        f"error: sweep 'lonely': all 2 jobs run failed (the log has 0 event(s); at least 2 encounters are needed "
-        f"to build a map); their rows are in {tmp_path / 'r.duckdb'}"]
+    line = (f"error: sweep 'lonely': all 2 jobs failed (the log has 0 event(s); at least 2 encounters are needed "
+            f"to build a map); their rows are in {tmp_path / 'r.duckdb'}")
+    assert proc.stderr.strip().splitlines() == [line]
     assert [row["error"] is not None for row in read_jobs(tmp_path / "r.duckdb")] == [True, True]
+    # run again: nothing to run, and it still says so
+    again = run_cli("sweep", path, "--store", tmp_path / "r.duckdb", "--workers", "1")
+    assert again.returncode == 1 and again.stderr.strip().splitlines() == [line]

@@ -440,9 +440,10 @@ def sweep(
             err.print(f"interrupted: finished jobs are saved in {store}; run the same command again to run the rest",
                       markup=False, highlight=False, soft_wrap=True)
         raise typer.Exit(130) from None
-    if summary.run and summary.failed == summary.run:  # no job mapped: the grid, not the data, is likely wrong
-        message = max(summary.errors.items(), key=lambda item: item[1])[0]
-        err.print(f"error: sweep {grid.name!r}: all {summary.run} jobs run failed ({message}); their rows are in "
+    errors = _stored_errors(store, grid.jobs)
+    if summary.total and sum(errors.values()) == summary.total:  # no job mapped: the grid, not the data, is likely wrong
+        message = max(errors.items(), key=lambda item: item[1])[0]
+        err.print(f"error: sweep {grid.name!r}: all {summary.total} jobs failed ({message}); their rows are in "
                   f"{store}", markup=False, highlight=False, soft_wrap=True)
         raise typer.Exit(1)
     if quiet:
@@ -458,6 +459,17 @@ def sweep(
     for message, count in sorted(summary.errors.items(), key=lambda item: -item[1])[:3]:
         out.print(f"failed {count}x: {message}", markup=False, highlight=False, soft_wrap=True)
     out.print(f"results: {store} (table jobs)", markup=False, highlight=False)
+
+
+def _stored_errors(store: Path, jobs) -> dict[str, int]:
+    """Error message -> number of ``jobs`` stored with it (those run now and those run before)."""
+    from collections import Counter
+
+    from .experiments.store import read_jobs
+
+    keys = {job.key for job in jobs}
+    return dict(Counter(row["error"] for row in read_jobs(store, columns=("key", "error"))
+                        if row["key"] in keys and row["error"] is not None))
 
 
 @app.command(epilog="Example: swarmtopo reproduce encmds --out reproduction/encmds --runs 5  "
