@@ -422,7 +422,9 @@ def sweep(
 ) -> None:
     """Run every simulate-and-map job of a grid on Dask and store one row per job.
 
-    Jobs already in the store are skipped, so a sweep can be resumed or grown.
+    Jobs already in the store are skipped, so a sweep can be resumed or grown.  A job
+    that cannot be mapped (too little data) is a stored row with its error; if every job
+    of the grid is, the sweep exits 1.
     """
     from .experiments.grid import read_sweep
     from .experiments.sweep import run_sweep
