@@ -416,3 +416,17 @@ def test_report_renders_in_headless_chromium(demo, evil, tmp_path):
     assert "true (from the arena): β0 = 1, β1 = 1" in verdict
     assert hostile["dialogs"] == []
     assert EVIL in hostile["probe"]["text"] and EVIL_IMG in hostile["probe"]["text"]  # shown as text
+
+
+def test_a_contact_trace_report_speaks_of_contact_loops_not_obstacles(demo):
+    from swarmtopo.experiments.sweep import contact_trace
+    from swarmtopo.report_html import report_html
+
+    log = contact_trace(demo["sim"].log)
+    tmap = map_encounters(log, MapConfig(seed=0, embed_dim=2, cycles=False))
+    assert tmap.to_json()["log"]["contact_trace"] is True
+    page = report_html(tmap, log=log)
+    assert "loops of the contact graph" in page and "(obstacles)" not in page
+    assert "A loop of the contact graph shows as a loop" in page and "A hole in the arena" not in page
+    # a log with status changes keeps the arena's words
+    assert "(obstacles)" in demo["html"] and "A hole in the arena shows as a loop" in demo["html"]

@@ -426,7 +426,7 @@ class TopologicalMap:
                        "diffusion_time_source": self.diffusion_time[1],
                        "window_length_used": self.window_length[0] if np.isfinite(self.window_length[0]) else None,
                        "window_source": self.window_length[1], "windows_left_out": self.windows_left_out},
-            "log": {"events": self.n_events, "agents": self.n_agents},
+            "log": {"events": self.n_events, "agents": self.n_agents, "contact_trace": self.contact_trace},
             "timings": {k: round(v, 6) for k, v in self.timings.items()},
             "software": {**self.software, "persistence_backend": self.diagram.backend},
         }

@@ -169,8 +169,10 @@ def _verdict_section(doc: dict, arena) -> str:
                                 "</span>" for n, b in true_betti.items())
         verdict = '<span class="ok">the map is right</span>' if agree else '<span class="bad">the map is wrong</span>'
         lines.append(f'<p class="truth">true (from the arena): {truth_items} &mdash; {verdict}</p>')
-    lines.append('<p class="note">&beta;<sub>0</sub> counts connected regions, &beta;<sub>1</sub> holes '
-                 "(obstacles); a confidence is the calibrated probability that the number is right.</p>")
+    holes = ("loops of the contact graph (groups linked in a cycle with no shortcut across it: not physical holes; "
+             "docs/real-data.md)" if doc["log"].get("contact_trace") else "holes (obstacles)")
+    lines.append(f'<p class="note">&beta;<sub>0</sub> counts connected regions, &beta;<sub>1</sub> {holes}; '
+                 "a confidence is the calibrated probability that the number is right.</p>")
     for warning in doc["warnings"]:
         lines.append(f'<p class="warning">warning: {html.escape(warning)}</p>')
     for small in doc["too_little_data"]:
@@ -225,9 +227,10 @@ def _cloud_section(tmap: TopologicalMap, log: EncounterLog, truth, arena, figure
     if not parts:
         return ""
     colouring = " and (right) by true position" if truth is not None else ""
+    loop = "A loop of the contact graph" if tmap.contact_trace else "A hole in the arena"
     return ('<section id="cloud"><h2>Encounter point cloud</h2>\n'
             f'<p class="note">The landmarks in the encounter metric, embedded by MDS, coloured by event time'
-            f"{colouring}. A hole in the arena shows as a loop in this cloud.</p>"
+            f"{colouring}. {loop} shows as a loop in this cloud.</p>"
             f'{"".join(parts)}</section>\n')
 
 
