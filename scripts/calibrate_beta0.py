@@ -32,9 +32,9 @@ from sklearn.linear_model import LogisticRegression
 from swarmtopo import __version__
 from swarmtopo.beta0 import Beta0Evidence, Beta0Model
 from swarmtopo.errors import SwarmtopoError
-from swarmtopo.experiments.accuracy import (CELLS, REPORTING_PER_CELL, SUITE, TUNING_PER_CELL, case, case_streams,
-                                            reliability, tuning_arena)
-from swarmtopo.experiments.sweep import build_arena, stripped_log
+from swarmtopo.experiments.accuracy import (CELLS, REPORTING_PER_CELL, SUITE, TUNING_PER_CELL, built_case, reliability,
+                                            tuning_arena)
+from swarmtopo.experiments.sweep import stripped_log
 from swarmtopo.io import write_json
 from swarmtopo.pipeline import MapConfig, split_regions
 from swarmtopo.sim import simulate
@@ -50,12 +50,7 @@ PREVIOUS_RATE = 0.9992
 def _cuts(task) -> list[dict]:
     split, cell_index, index = task
     cell = CELLS[cell_index]
-    if split == "tuning":
-        _, _, arena, stream = tuning_arena(cell, index)
-    else:
-        table, seed = case(cell, "reporting", index)
-        streams = case_streams(seed)
-        arena, stream = build_arena(table, streams["arena"]), streams["simulation"]
+    _, _, arena, stream = tuning_arena(cell, index) if split == "tuning" else built_case(cell, "reporting", index)
     log = stripped_log(simulate(arena, cell.agents, cell.duration, rng=stream).log)
     rows = []
     for cut in CUTS:
@@ -91,13 +86,16 @@ def fit(evidence: list[Beta0Evidence], right: np.ndarray, provenance: dict) -> B
         chosen = np.array(chosen)
         x = np.array([[Beta0Model.feature(e)] for e, keep in zip(evidence, chosen) if keep])
         y = right[chosen]
+        if len(np.unique(y)) < 2:
+            raise SystemExit(f"the {part}-region cuts are all {'right' if y.all() else 'wrong'} ({len(y)} cuts): "
+                             "too few to fit; use a larger --tuning-per-cell")
         model = LogisticRegression(C=1.0).fit(x, y)
         pairs[part] = (float(model.intercept_[0]), float(model.coef_[0, 0]))
         provenance[f"{part}_maps"], provenance[f"{part}_right"] = int(len(y)), int(y.sum())
     return Beta0Model(pairs["one"], pairs["several"], provenance)
 
 
-def _table(records: list[dict]) -> str:
+def _table(records: list[dict]) -> tuple[str, dict]:
     rel = reliability(records, 0)
     lines = ["| confidence | maps | mean confidence | fraction right [Wilson 95 %] |", "|---|---|---|---|"]
     for b in rel["bins"]:

@@ -442,8 +442,9 @@ def sweep(
             err.print(f"interrupted: finished jobs are saved in {store}; run the same command again to run the rest",
                       markup=False, highlight=False, soft_wrap=True)
         raise typer.Exit(130) from None
-    errors = _stored_errors(store, grid.jobs)
-    if summary.total and sum(errors.values()) == summary.total:  # no job mapped: the grid, not the data, is likely wrong
+    # every job failed (the grid, not the data, is likely wrong): only then read the rows run before
+    errors = _stored_errors(store, grid.jobs) if summary.failed == summary.run else {}
+    if summary.total and sum(errors.values()) == summary.total:
         message = max(errors.items(), key=lambda item: item[1])[0]
         err.print(f"error: sweep {grid.name!r}: all {summary.total} jobs failed ({message}); their rows are in "
                   f"{store}", markup=False, highlight=False, soft_wrap=True)

@@ -212,7 +212,8 @@ def vote(classifier, windows: Sequence[Diagram], events: Sequence[int] | None = 
     off = [abs(c - betti[key]) for c in counts[key]]
     nearest = [i for i, x in enumerate(off) if x == min(off)]
     if events is not None:
-        nearest = [i for i in nearest if 2 * events[i] >= max(events[j] for j in nearest)]
+        fullest = max(events[i] for i in nearest)
+        nearest = [i for i in nearest if 2 * events[i] >= fullest]
     margins = [classifier.margin(windows[i], key) for i in nearest]
     return betti, nearest[int(np.argmax(margins))], counts
 

@@ -141,14 +141,20 @@ def case(cell: Cell, split: str, index: int) -> tuple[dict[str, Any], int]:
     raise SwarmtopoError(f"{SUITE}: no placeable arena for {cell.name} case {index} in {MAX_ATTEMPTS} attempts")
 
 
-def tuning_arena(cell: Cell, index: int):
-    """(arena table, case seed, built arena, simulation stream) of tuning case ``index``
-    of ``cell``, opened inside :func:`tuning_session` (the benchmark scripts that
-    simulate tuning cases themselves: ``benchmarks/levers.py`` and others)."""
-    with tuning_session():
-        table, seed = case(cell, "tuning", index)
+def built_case(cell: Cell, split: str, index: int):
+    """(arena table, case seed, built arena, simulation stream) of case ``index`` of
+    ``cell``: the arena and simulation a job of that case gets (:func:`case_streams`)."""
+    table, seed = case(cell, split, index)
     streams = case_streams(seed)
     return table, seed, build_arena(table, streams["arena"]), streams["simulation"]
+
+
+def tuning_arena(cell: Cell, index: int):
+    """:func:`built_case` of tuning case ``index`` of ``cell``, opened inside
+    :func:`tuning_session` (the benchmark scripts that simulate tuning cases themselves:
+    ``benchmarks/levers.py`` and others)."""
+    with tuning_session():
+        return built_case(cell, "tuning", index)
 
 
 def _jobs(split: str, per_cell: int, pipelines: dict[str, dict[str, Any]], cells=CELLS) -> list[Job]:
