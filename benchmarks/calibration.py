@@ -10,6 +10,10 @@ model fitted without it (scikit-learn ``cross_val_predict``, 10 folds by positio
 Prints the Brier score (against a constant confidence equal to the rate) and log loss
 of those predictions, and the reliability table in the bins of the accuracy benchmark.
 
+These are the score-only classifier's maps (tune_accuracy's rows hold no A_k); the
+shipped default's gated confidence is fitted the same way, on z, by
+``scripts/fit_agreement_gate.py``.
+
 Feature sets: ``z`` (shipped: how many standard errors the pooled scores are from
 changing the vote, ``ratio.standardised_margin``); the previous calibration's
 agreement of the windows with the vote, log margin and log number of windows; and

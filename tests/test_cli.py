@@ -159,6 +159,8 @@ def test_bad_option_values(simulated, tmp_path):
     assert_one_line_error(run("map", simulated[0], "--out", tmp_path / "x", "--metric", "euclid"),
                           "unknown metric 'euclid'", code=2)
     assert_one_line_error(run("map", simulated[0], "--max-windows", 2), "at least the number of window scales", code=2)
+    assert_one_line_error(run("map", simulated[0], "--agreement", "never"), "agreement must be one of auto, always",
+                          code=2)
     assert_one_line_error(run("map", simulated[0], "--landmarks", 2001), "'--landmarks'", code=2)
     for window in ("inf:", ":-inf"):
         assert_one_line_error(run("map", simulated[0], "--window", window), "would hold nothing", code=2)
@@ -256,6 +258,10 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     assert capped.returncode == 0, capped.stderr
     doc = json.loads((tmp_path / "c" / "map.json").read_text())
     assert doc["params"]["max_windows"] == 3 and len(doc["regions"][0]["windows"]) == 3  # one per length
+    inspected = run("map", simulated[0], "--out", tmp_path / "i", "-q", "--window-length", "4", "--agreement", "always")
+    assert inspected.returncode == 0, inspected.stderr
+    agreement = json.loads((tmp_path / "i" / "map.json").read_text())["regions"][0]["agreement"]
+    assert len(agreement) == 5 and all(0 <= a <= 1 for a in agreement)
     every = run("map", simulated[0], "--out", tmp_path / "e", "-q", "--window-length", "4", "--max-windows", "none")
     assert every.returncode == 0, every.stderr
     doc = json.loads((tmp_path / "e" / "map.json").read_text())

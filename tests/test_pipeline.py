@@ -1,6 +1,7 @@
 """End-to-end mapping: log -> TopologicalMap, checked against known topology."""
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -12,7 +13,7 @@ from swarmtopo.log import EncounterLog
 from swarmtopo.pipeline import (DIFFUSION_GAP_FACTOR, HOP_GAP_FACTOR, WHOLE_LOG, MapConfig, _share_landmarks,
                                 _scaled_windows, _windows, map_encounters, mean_agent_gap, resolve_diffusion_time, resolve_hop_cost,
                                 resolve_window, shipped_classifier_for)
-from swarmtopo.ratio import longest_bars
+from swarmtopo.ratio import RatioClassifier, RatioThresholds, region_reader
 from swarmtopo.sim import simulate
 
 FAST = dict(embed_dim=0)
@@ -367,14 +368,14 @@ def test_windowed_map_pools_and_records_its_windows():
     tmap = map_encounters(log, MapConfig(window_length=12.0, window_scales=(1.0,), **FAST))
     region = tmap.regions[0]
     assert len(region.windows) == 4  # span ~30 s, 12 s windows every <= 6 s
-    classifier = load_classifier("default")
     bars = [w.diagram for w in region.windows]
+    classifier = region_reader(load_classifier("default"), bars, region.agreement)
     assert region.betti[1] == classifier.pooled_betti(bars)[1]  # the classifier's pooling of the windows
     assert [w.betti[1] for w in region.windows] == [classifier.betti(w.diagram)[1] for w in region.windows]
     counts = [w.betti[1] for w in region.windows]
     rep = region.windows[region.window].betti[1]  # the representative window agrees with the vote if any does
     assert rep == region.betti[1] or region.betti[1] not in counts
-    assert list(region.counted[1]) == list(longest_bars(region.diagram, 1, region.betti[1]))
+    assert list(region.counted[1]) == list(classifier.counted_bars(region.diagram, 1, region.betti[1]))
     assert region.diagram is region.windows[region.window].diagram
     doc = tmap.to_json()
     assert [w["betti"]["1"] for w in doc["regions"][0]["windows"]] == [w.betti[1] for w in region.windows]
@@ -397,6 +398,30 @@ def test_loops_are_drawn_from_the_chosen_window_run_again_with_cocycles():
             np.testing.assert_array_equal(a.diagram[n], b.diagram[n])
     assert with_loops.betti == without.betti and with_loops.window == without.window
     assert len(with_loops.cycles) == with_loops.betti[1] and without.cycles == []
+
+def test_the_gate_reads_each_regions_cross_window_agreement():
+    log = simulate(default_arena(), 150, 30.0, rng=2).log
+    config = MapConfig(seed=1, cycles=False, window_length=10.0, window_scales=(1.0,), **FAST)
+    q, tau = 0.5, 4.0
+
+    def mapped(b=None, **options):
+        return map_encounters(log, replace(config, **options), classifier=RatioClassifier({1: RatioThresholds(q, tau, b)}))
+
+    score_only = mapped()
+    assert score_only.regions[0].agreement is None and score_only.timings["agreement"] == 0  # not asked for
+    assert score_only.betti[1] >= 1  # the arena's hole passes the score
+    lenient, strict = mapped(0.0), mapped(0.999)
+    a = lenient.regions[0].agreement
+    assert a.shape == (5,) and np.all((a >= 0) & (a <= 1)) and a[0] > 0.8  # the hole is one loop in every window
+    np.testing.assert_array_equal(strict.regions[0].agreement, a)
+    assert lenient.betti[1] == score_only.betti[1]  # A_k > 0 for every passing rank: nothing vetoed
+    assert strict.betti[1] == 0 and strict.regions[0].counted[1].size == 0  # every passing rank vetoed
+    # "always": A_k with any classifier, the vote unchanged; map.json lists it
+    always = mapped(agreement="always")
+    np.testing.assert_array_equal(always.regions[0].agreement, a)
+    assert always.betti == score_only.betti
+    assert json.loads(json.dumps(always.to_json()))["regions"][0]["agreement"] == pytest.approx(list(a))
+
 
 def test_a_log_without_status_changes_is_read_by_the_trace_classifier():
     from swarmtopo.experiments.sweep import contact_trace

@@ -192,7 +192,7 @@ def test_earlier_formats_read_as_median_pooling_when_their_gates_are_off():
         old = {"format": fmt, "thresholds": {"1": {"q": 0.5, "tau": 2.0, "rho": 1.0, "kappa": 0.0, **extra}}}
         model = RatioClassifier.from_json(old)
         assert model.pooling == "median" and model.thresholds_[1] == TH
-        assert model.to_json()["format"] == "swarmtopo-ratio-classifier/3"
+        assert model.to_json()["format"] == "swarmtopo-ratio-classifier/4"
     gated = {"format": "swarmtopo-ratio-classifier/2",
              "thresholds": {"1": {"q": 0.5, "tau": 2.0, "rho": 2.0, "kappa": 0.0, "gamma": 0.0}}}
     with pytest.raises(InputError, match="old.json.*thresholds.1.*no longer applied"):
@@ -215,10 +215,13 @@ def test_bad_thresholds_and_files_are_input_errors():
                                    "thresholds": {"1": {"q": 0.5, "tau": 2.0}}})
 
 
-def test_shipped_default_is_a_calibrated_mean_pooled_ratio_classifier():
+def test_shipped_default_is_a_calibrated_mean_pooled_ratio_classifier_gated_by_agreement():
     model = load_classifier("default")
     assert isinstance(model, RatioClassifier) and model.pooling == "mean"
     assert set(model.calibration_) == {"1"}  # beta_0's confidence is the pipeline's (swarmtopo.beta0)
+    assert model.gated and 0 < model.thresholds_[1].agreement < 1
+    assert model.provenance_["score_only"]["tau"] > 1  # the score-only tau_1 it was fitted from
+    assert not load_classifier("trace").gated  # contact traces: the score alone
 
 
 @pytest.mark.parametrize("key, value, message", [
@@ -246,3 +249,55 @@ def test_an_earlier_classifier_file_with_a_beta0_rate_still_loads(tmp_path):
     path = tmp_path / "c.json"
     path.write_text(json.dumps(obj))
     assert load_classifier(path).calibration_ == load_classifier("default").calibration_
+
+
+# -- the agreement gate -------------------------------------------------------------------
+GATED = RatioThresholds(q=0.5, tau=2.0, agreement=0.7)
+# three windows, each with bars of lengths 16, 5, 3 over noise of length 2 (median 2):
+# scores ln 8, ln 2.5, ln 1.5, 0...: ranks 1 and 2 pass ln 2, rank 3 does not
+REGION = windows_of(*[[[0, 16], [0, 5], [0, 3], [0, 2], [0, 2], [0, 2], [0, 2]]] * 3)
+
+
+def test_a_passing_rank_with_low_agreement_is_vetoed_and_dropped_from_every_window():
+    model = RatioClassifier({1: GATED})
+    assert model.gated and model.needs_agreement(REGION)
+    assert model.pooled_betti(REGION) == {1: 2}  # the gate needs its A_k: the score alone counts 2
+    view = model.with_agreement(REGION, np.array([0.9, 0.5, 0.1, 0.1, 0.1]))  # rank 3 fails the score anyway
+    assert view.vetoed_ == {1: (1,)} and model.vetoed_ == {}
+    assert view.pooled_betti(REGION) == {1: 1} and view.betti(REGION[0]) == {1: 1}
+    # the drawn bar is the longest; the next counted one would skip the vetoed [0, 5]
+    assert [tuple(REGION[0][1][i]) for i in view.counted_bars(REGION[0], 1, 2)] == [(0.0, 16.0), (0.0, 3.0)]
+    # z is read off the scores without the vetoed rank: ln 8 above, ln 1.5 below ln 2 (not ln 2.5 above)
+    kept = np.delete(score_matrix(REGION, 1, 0.5), 1, axis=1)
+    assert view.region_features(REGION, 1)["z"] == pytest.approx(standardised_margin(kept, 1, 2.0))
+    assert view.region_features(REGION, 1)["z"] != pytest.approx(model.region_features(REGION, 1)["z"])
+    # the literal rule: #{k : S_k > ln tau and not (k <= BARS and A_k <= b)}
+    for agreement, count in (([0.9, 0.9, 0.0, 0.0, 0.0], 2), ([0.7, 0.9, 1, 1, 1], 1), ([0.1, 0.2, 1, 1, 1], 0),
+                             ([np.nan] * 5, 2)):
+        assert model.with_agreement(REGION, np.array(agreement)).pooled_betti(REGION) == {1: count}
+
+
+def test_the_gate_needs_agreement_only_when_a_rank_passes():
+    quiet = windows_of(*[[[0, 3], [0, 2], [0, 2], [0, 2]]] * 2)  # S_1 = ln 1.5 < ln 2
+    model = RatioClassifier({1: GATED})
+    assert not model.needs_agreement(quiet)
+    assert model.with_agreement(quiet, None).pooled_betti(quiet) == {1: 0}
+    with pytest.raises(SwarmtopoError, match="cross-window cycle agreement"):
+        model.with_agreement(REGION, None)
+    assert not RatioClassifier({1: TH}).gated and not RatioClassifier({1: TH}).needs_agreement(REGION)
+
+
+def test_a_gated_classifier_round_trips_and_bad_gates_are_refused(tmp_path):
+    model = RatioClassifier({1: GATED}, provenance={"name": "g"})
+    path = tmp_path / "g.json"
+    model.save(path)
+    again = load_classifier(path)
+    assert again.thresholds_[1] == GATED and again.to_json() == model.to_json()
+    assert again.to_json()["format"] == "swarmtopo-ratio-classifier/4" and "agreement_gate" in again.describe()
+    # a /3 file never had a gate
+    three = {"format": "swarmtopo-ratio-classifier/3", "thresholds": {"1": {"q": 0.5, "tau": 2.0}}}
+    assert not RatioClassifier.from_json(three).gated
+    for thresholds, pooling in (({1: RatioThresholds(0.5, 2.0, 1.0)}, "mean"), ({1: GATED}, "median"),
+                                ({2: GATED}, "mean")):
+        with pytest.raises(InputError, match="agreement gate"):
+            RatioClassifier(thresholds, pooling=pooling)

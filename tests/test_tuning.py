@@ -4,9 +4,11 @@ the literal classifier at every grid point; cross-fitted calibration."""
 import dataclasses
 
 import numpy as np
+import pytest
 
-from swarmtopo.experiments.tuning import (Q_GRID, TAU_GRID, TuningMap, calibrated_classifier, cross_fitted_features,
-                                         cross_validated, exact, fit_thresholds, grid_estimates)
+from swarmtopo.experiments.tuning import (A_GRID, B_GRID, Q_GRID, TAU_GRID, TuningMap, calibrated_classifier,
+                                         cross_fitted_features, cross_validated, exact, fit_gate, fit_thresholds,
+                                         gate_estimates, grid_estimates)
 from swarmtopo.persistence import Diagram
 from swarmtopo.ratio import RatioClassifier, RatioThresholds
 
@@ -94,3 +96,47 @@ def test_cross_fitted_features_read_each_one_region_map_with_thresholds_fitted_w
         assert features[pos] == RatioClassifier({1: th}).region_features(single[i].regions[0], 1)
         assert correct[pos] == bool(exact([single[i]], th)[0])
     assert correct[order.index(3)] is False
+
+
+def gated_maps(n, rng):
+    """One-region maps whose true holes agree (A ~ 0.9) and whose one noise loop of score
+    ln 2.4-ln 3.6 over the median (between the grid's a and above some) does not (A ~ 0.4)."""
+    maps = []
+    for _ in range(n):
+        holes = int(rng.integers(0, 4))
+        windows = []
+        for _ in range(3):
+            noise = [[b, b + rng.uniform(0.9, 1.1)] for b in rng.uniform(1, 2, 10)]
+            signal = [[1.0, 1.0 + rng.uniform(8, 12)] for _ in range(holes)]
+            fake = [[1.0, 1.0 + rng.uniform(6.5, 7.0)]]  # scores about ln 6.5-7: above a = 1.84 and below 2
+            windows.append(Diagram(pairs=(np.array([[0.0, np.inf]]), np.array(noise + signal + fake)),
+                                   backend="test"))
+        agreement = np.r_[np.full(holes, 0.9), 0.4, np.full(4, 0.2)][:5]
+        maps.append(TuningMap(regions=(tuple(windows),), est_betti0=1, true_betti0=1, true_betti1=holes, cell="c",
+                              agreement=(agreement,)))
+    return maps
+
+
+def test_vectorised_gate_grid_equals_the_literal_gated_classifier():
+    rng = np.random.default_rng(5)
+    maps = gated_maps(10, rng)
+    single = synthetic_maps(1, rng)[0]  # a region without overlapping windows: NaN agreement vetoes nothing
+    maps.append(dataclasses.replace(single, agreement=(np.full(5, np.nan),)))
+    truth = np.array([m.true_betti1 for m in maps])
+    est = gate_estimates(maps, 0.5)
+    for i in range(0, len(A_GRID), 4):
+        for j in range(0, len(B_GRID), 6):
+            literal = exact(maps, RatioThresholds(0.5, float(np.exp(A_GRID[i])), B_GRID[j]))
+            assert np.array_equal(literal, est[:, i, j] == truth), (A_GRID[i], B_GRID[j])
+
+
+def test_the_gate_fit_vetoes_the_disagreeing_loop_the_score_alone_counts():
+    maps = gated_maps(30, np.random.default_rng(6))
+    gate = fit_gate(maps, 0.5)
+    assert exact(maps, gate).all() and 0.4 <= gate.agreement < 0.9
+    # the score alone cannot tell the loop of ln 6.5-7 from the holes of ln 8-12 at a low threshold
+    assert not exact(maps, RatioThresholds(0.5, float(np.exp(1.84)))).all()
+    # maps stored without A_k cannot be read by a gate that needs them
+    bare = [dataclasses.replace(m, agreement=()) for m in maps]
+    with pytest.raises(ValueError, match="agreement='always'"):
+        gate_estimates(bare, 0.5)

@@ -321,6 +321,11 @@ def map_command(
         help="Cap of the time windows mapped, all lengths together, at least one per length (default 48, more "
              "than any benchmark map pools): a longer log maps an evenly spaced share of each length's windows, so "
              "its time stops growing with its length; 'none' maps every window."),
+    agreement: str = typer.Option(
+        "auto", "--agreement",
+        help="When to compute each region's cross-window cycle agreement A_1..A_5 (map.json regions[].agreement: "
+             "is each of the longest loops the same loop in overlapping windows?): auto (default) where the "
+             "default classifier's gate needs it, always for every region, to inspect."),
     classifier: Optional[str] = typer.Option(
         None, "--classifier",
         help="Betti classifier: default (tuned on the accuracy benchmark), trace (the same tuned on its logs read "
@@ -359,7 +364,7 @@ def map_command(
                            wall_follow_weight=wall_follow_option(wall_follow_weight),
                            window_length=seconds_option(window_length),
                            window_scales=window_scales or MapConfig.window_scales,
-                           max_windows=max_windows_option(max_windows)).validate()
+                           max_windows=max_windows_option(max_windows), agreement=agreement).validate()
     except SwarmtopoError as exc:  # options that do not go together: a usage error
         raise typer.BadParameter(str(exc)) from None
     model = load_classifier(classifier) if classifier else None  # None: the shipped one for the log

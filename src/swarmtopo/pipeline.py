@@ -37,7 +37,8 @@ from .io import jsonable
 from .landmarks import SUBSAMPLERS, Landmarks, knn_distances, knn_maxmin, maxmin, probabilistic_maxmin
 from .log import EncounterLog, exact_time
 from .persistence import Diagram, PersistenceResult, rips_persistence
-from .ratio import longest_bars, vote
+from .agreement import overlapping, rank_agreement, window_coordinates
+from .ratio import RatioClassifier, longest_bars, region_reader, vote
 
 
 MIN_REGION_AGENTS = 3
@@ -73,6 +74,8 @@ are all pooled (windows of 15, 20 and 25 encounters per agent; docs/tuning.md)."
 MAX_WINDOWS = 48
 """Default ``MapConfig.max_windows``: more than any map of the accuracy benchmark pools
 (at most 44), so its measured accuracy holds; a longer log maps an evenly spaced subset."""
+AGREEMENT_MODES = ("auto", "always")
+"""``MapConfig.agreement``: compute A_k when the classifier's vote needs it, or for every region."""
 WHOLE_LOG = float("inf")
 """``MapConfig.window_length`` that maps the whole log at once (the paper)."""
 
@@ -103,7 +106,7 @@ def max_windows_option(value: str | int | None) -> int | None:
     return None if value == "none" else int(value)
 
 
-STAGES = ("graph", "landmarks", "persistence", "embedding", "classify", "cycles")
+STAGES = ("graph", "landmarks", "persistence", "agreement", "classify", "embedding", "cycles")
 """Stage names passed to ``map_encounters``'s progress callback, in order."""
 
 
@@ -193,6 +196,11 @@ class MapConfig:
     cycles
         Find a representative loop of landmarks for each counted H1 bar (where the
         holes are; :mod:`swarmtopo.cycles`).  Off in sweeps, which store no loops.
+    agreement
+        When to compute each region's cross-window cycle agreement A_1 .. A_5
+        (:mod:`swarmtopo.agreement`): ``"auto"`` (default) only where the classifier's
+        gate needs it (a gated classifier, and a rank whose score passes), ``"always"``
+        for every region (fitting the gate: ``scripts/fit_agreement_gate.py``).
     """
 
     metric: str = "hybrid"
@@ -216,6 +224,7 @@ class MapConfig:
     min_region_events: int = 50
     embed_dim: int = 3
     cycles: bool = True
+    agreement: str = "auto"
 
     def __post_init__(self):
         scales = self.window_scales
@@ -262,6 +271,8 @@ class MapConfig:
             raise SwarmtopoError(f"maxdim must be 1 or 2, got {self.maxdim}")
         if self.embed_dim not in (0, 2, 3):
             raise SwarmtopoError(f"embed_dim must be 0, 2 or 3, got {self.embed_dim}")
+        if self.agreement not in AGREEMENT_MODES:
+            raise SwarmtopoError(f"agreement must be one of {', '.join(AGREEMENT_MODES)}, got {self.agreement!r}")
         if self.window is not None:
             t0, t1 = self.window
             for end in (t0, t1):
@@ -319,6 +330,7 @@ class RegionMap:
     embedding: Embedding | None
     windows: list[WindowMap]
     window: int  # index of the representative window
+    agreement: np.ndarray | None = None  # A_1 .. A_5 (swarmtopo.agreement); None where not computed
 
 
 @dataclass(eq=False)
@@ -411,6 +423,7 @@ class TopologicalMap:
                     "cycles": [c.to_json() for c in r.cycles],
                     "windows": [w.to_json() for w in r.windows],
                     "window": r.window,
+                    "agreement": agreement_json(r.agreement),
                     "diagrams": r.diagram.to_json(),
                     "mds_stress": None if r.embedding is None else float(r.embedding.stress),
                     "warnings": r.warnings,
@@ -561,33 +574,44 @@ def map_encounters(
     regions: list[RegionMap] = []
     for comp, n_land in zip(regions_idx, shares):
         region_events = graph.event_index[event_comp == comp]
-        windows = []
+        windows, parts = [], []  # the region's windows and the graphs they were mapped on
         for span, wgraph, wlabels in window_graphs:
             part = _region_part(wgraph, wlabels, region_events, log, config)
             if part is not None:
                 windows.append(_map_window(span, part, n_land, config, rng, timings, say))
+                parts.append(part)
         fallback = []
         if not windows:  # no window holds enough of this region: map its whole log instead
             whole = graph.subgraph(np.flatnonzero(labels == comp))
-            windows = [_map_window(None, whole, n_land, config, rng, timings, say)]
+            windows, parts = [_map_window(None, whole, n_land, config, rng, timings, say)], [whole]
             if lengths_tried:
                 lo, hi = lengths_tried[0], lengths_tried[-1]
                 tried = f"{lo:.3g}" if lo == hi else f"{lo:.3g}-{hi:.3g}"
                 fallback = [f"no window ({tried} s long) holds {config.min_region_events} encounters of this region "
                             f"among {MIN_REGION_AGENTS} agents: its whole log was mapped instead"]
+        diagrams = [w.diagram for w in windows]
+        gated = isinstance(classifier, RatioClassifier) and classifier.gated
+        agreement = None
+        if config.agreement == "always" or (gated and classifier.needs_agreement(diagrams)):
+            say("agreement")
+            t0 = time.perf_counter()
+            agreement = region_agreement(windows, parts)
+            timings["agreement"] += time.perf_counter() - t0
+        del parts
         say("classify")
         t0 = time.perf_counter()
-        diagrams = [w.diagram for w in windows]
-        voted = vote(classifier, diagrams, [w.n_events for w in windows])
+        region_classifier = region_reader(classifier, diagrams, agreement)
+        voted = vote(region_classifier, diagrams, [w.n_events for w in windows])
         betti_region, rep, counts = voted
         for w, *window_counts in zip(windows, *counts.values()):
             w.betti = dict(zip(counts, window_counts))
         chosen = windows[rep]
-        confidence_region = classifier.region_confidence(diagrams, voted)
+        confidence_region = region_classifier.region_confidence(diagrams, voted)
         sampling = _sampling_warnings(chosen.scales, len(chosen.landmarks.nodes), config)
         if sampling:  # calibrated with the automatic landmark count only: no number to give
             confidence_region = dict.fromkeys(confidence_region)
-        counted = {n: longest_bars(chosen.diagram, n, count) for n, count in betti_region.items()}
+        counted = {n: (region_classifier.counted_bars(chosen.diagram, n, count) if gated
+                       else longest_bars(chosen.diagram, n, count)) for n, count in betti_region.items()}
         thresholds = classifier.length_thresholds(chosen.diagram)
         timings["classify"] += time.perf_counter() - t0
         say("embedding")
@@ -612,6 +636,7 @@ def map_encounters(
             embedding=emb,
             windows=windows,
             window=rep,
+            agreement=agreement,
         ))
         if config.cycles:
             say("cycles")
@@ -676,6 +701,20 @@ def _map_window(span, sub: EncounterGraph, n_land: int | None, config: MapConfig
                      landmark_events=sub.representative_event()[land.nodes],
                      scales=RegionScales(knn=knn_scale, cover_radius=float(land.cover_radius)),
                      persistence=persistence)
+
+
+def region_agreement(windows: list[WindowMap], graphs: list[EncounterGraph]) -> np.ndarray:
+    """A_1 .. A_5 of a region from its windows and the graphs they were mapped on (:mod:`swarmtopo.agreement`);
+    only windows that overlap another get coordinates."""
+    spans = [(w.t0, w.t1) for w in windows]
+    coordinates = [window_coordinates(w.landmarks.distances, w.diagram, w.landmarks.nodes, g)
+                   if overlapping(spans, i) else None for i, (w, g) in enumerate(zip(windows, graphs))]
+    return rank_agreement(coordinates, spans)
+
+
+def agreement_json(agreement: np.ndarray | None) -> list[float | None] | None:
+    """A_k as JSON: null where undefined (no two windows overlap), the whole list null if not computed."""
+    return None if agreement is None else [None if np.isnan(a) else float(a) for a in agreement]
 
 
 def shipped_classifier_for(log: EncounterLog) -> str:

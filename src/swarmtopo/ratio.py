@@ -29,6 +29,15 @@ A region's log is cut into time windows of several lengths (``MapConfig.window_l
 
 Either way the counted bars of a window drawn for the user are its beta_hat_n longest.
 
+Agreement gate (format /4; mean pooling, dimension 1).  With ``agreement`` b set, a rank
+k <= ``agreement.BARS`` whose pooled score passes (S_k > ln tau_1) is *vetoed* when its
+cross-window cycle agreement A_k (:mod:`swarmtopo.agreement`: is the k-th loop the same
+loop in overlapping windows?) is at most b; a region without A_k (one window) vetoes
+nothing.  A vetoed rank is dropped from every window's score sequence
+(:meth:`RatioClassifier.with_agreement`), so beta_hat_1 = #{k : S_k > ln tau_1 and not
+vetoed}, and the windows' own counts, the representative window, the drawn bars and z
+below are those of the sequences without it.
+
 Confidence.  For each region the feature is the vote's *standardised margin* z:
 how many standard errors the pooled scores are from changing the vote beta,
 
@@ -52,6 +61,7 @@ off (as median pooling) and refused otherwise.
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 from typing import Any, Sequence
 
@@ -61,12 +71,14 @@ from sklearn.linear_model import LogisticRegression
 
 from . import __version__
 from ._validate import check_format
+from .agreement import BARS
 from .errors import InputError, SwarmtopoError
 from .persistence import Diagram
 
-RATIO_FORMAT = "swarmtopo-ratio-classifier/3"
-READ_FORMATS = ("swarmtopo-ratio-classifier/1", "swarmtopo-ratio-classifier/2", RATIO_FORMAT)
-"""Readable formats: /1 and /2 files pool by the median of the windows' counts."""
+RATIO_FORMAT = "swarmtopo-ratio-classifier/4"
+READ_FORMATS = ("swarmtopo-ratio-classifier/1", "swarmtopo-ratio-classifier/2", "swarmtopo-ratio-classifier/3",
+                RATIO_FORMAT)
+"""Readable formats: /1 and /2 files pool by the median of the windows' counts; only /4 files gate by agreement."""
 POOLINGS = ("mean", "median")
 MAX_MARGIN = 3.0
 """Cap of the log margin (a score e^3 = 20 times off the threshold is as sure as it gets)."""
@@ -85,13 +97,15 @@ LOG_RATIO_CAP = float(np.log(1e3))
 
 @dataclass(frozen=True)
 class RatioThresholds:
-    """(q_n, tau_n) of one dimension: a bar counts in its window when l > tau_n l_q."""
+    """(q_n, tau_n) of one dimension: a bar counts in its window when l > tau_n l_q; and the
+    agreement gate b (None: no gate), which vetoes a passing rank with A_k <= b (module docstring)."""
 
     q: float
     tau: float
+    agreement: float | None = None
 
     def to_json(self) -> dict[str, float]:
-        return {"q": self.q, "tau": self.tau}
+        return {"q": self.q, "tau": self.tau, **({} if self.agreement is None else {"agreement": self.agreement})}
 
 
 def noise_length(diagram: Diagram, dim: int, q: float) -> float:
@@ -130,7 +144,11 @@ def confidence_design(features: Sequence[dict[str, float]], names: Sequence[str]
 
 def score_matrix(diagrams: Sequence[Diagram], dim: int, q: float) -> np.ndarray:
     """(W, K) scores s^w_(k) of the W windows, a rank a window has no bar for scoring 0."""
-    ranked = [window_scores(d, dim, q) for d in diagrams]
+    return _padded([window_scores(d, dim, q) for d in diagrams])
+
+
+def _padded(ranked: Sequence[np.ndarray]) -> np.ndarray:
+    """The windows' decreasing score sequences as rows of one matrix, missing ranks 0."""
     out = np.zeros((len(ranked), max((len(s) for s in ranked), default=0)))
     for w, s in enumerate(ranked):
         out[w, :len(s)] = s
@@ -175,11 +193,13 @@ def score_margin(scores: np.ndarray, tau: float) -> float:
     return float(min([MAX_MARGIN, *sides]))
 
 
-def longest_bars(diagram: Diagram, dim: int, count: int) -> np.ndarray:
-    """Indices into ``diagram[dim]`` of its ``count`` longest bars (infinite first; ties by position)."""
+def longest_bars(diagram: Diagram, dim: int, count: int, skip: Sequence[int] = ()) -> np.ndarray:
+    """Indices into ``diagram[dim]`` of its ``count`` longest bars (infinite first; ties by position),
+    the bars of the 0-based length ranks in ``skip`` (vetoed ranks) left out."""
     if dim > diagram.maxdim or count <= 0:
         return np.empty(0, np.int64)
-    return np.argsort(-diagram.lengths(dim), kind="stable")[:count]
+    return np.delete(np.argsort(-diagram.lengths(dim), kind="stable"),
+                     [k for k in skip if k < len(diagram[dim])])[:count]
 
 
 def median_vote(counts: Sequence[int]) -> int:
@@ -203,7 +223,7 @@ def vote(classifier, windows: Sequence[Diagram], events: Sequence[int] | None = 
     """
     if not windows:
         raise SwarmtopoError("no window of this region has enough events to map")
-    per_window = [classifier.betti(d) for d in windows]
+    per_window = [classifier.betti(d) for d in windows]  # a classifier with_agreement: without its vetoed ranks
     counts = {n: [c[n] for c in per_window] for n in per_window[0]}
     betti = classifier.pooled_betti(windows)
     if not counts:
@@ -216,6 +236,17 @@ def vote(classifier, windows: Sequence[Diagram], events: Sequence[int] | None = 
         nearest = [i for i in nearest if 2 * events[i] >= fullest]
     margins = [classifier.margin(windows[i], key) for i in nearest]
     return betti, nearest[int(np.argmax(margins))], counts
+
+
+def region_reader(classifier, windows: Sequence[Diagram], agreement) -> Any:
+    """How ``classifier`` reads one region: :meth:`RatioClassifier.with_agreement` if it gates
+    by agreement, else itself.  ``agreement``: the region's A_k (array, or a JSON list with
+    null for NaN), None if not computed."""
+    if not (isinstance(classifier, RatioClassifier) and classifier.gated):
+        return classifier
+    if agreement is not None:
+        agreement = np.array([np.nan if a is None else a for a in agreement], dtype=float)
+    return classifier.with_agreement(windows, agreement)
 
 
 class RatioClassifier:
@@ -233,6 +264,12 @@ class RatioClassifier:
         Free-form record of how it was fitted (name, data, script).
     pooling
         ``"mean"`` (pooled scores) or ``"median"`` (lower median of the windows' counts).
+
+    Attributes
+    ----------
+    vetoed_
+        ``{n: 0-based ranks}`` dropped from every window's scores; empty but on the
+        region view :meth:`with_agreement` returns.
     """
 
     def __init__(self, thresholds: dict[int, RatioThresholds], calibration: dict | None = None,
@@ -245,6 +282,12 @@ class RatioClassifier:
         if pooling not in POOLINGS:
             raise InputError(f"unknown pooling; expected one of {', '.join(POOLINGS)}", column="pooling",
                              value=pooling)
+        for n, th in thresholds.items():
+            if th.agreement is not None and (int(n) != 1 or pooling != "mean" or isinstance(th.agreement, bool) or
+                                             not isinstance(th.agreement, (int, float)) or
+                                             not 0.0 <= th.agreement < 1.0):
+                raise InputError("an agreement gate needs dimension 1, mean pooling and 0 <= agreement < 1",
+                                 column=f"thresholds.{n}.agreement", value=th.agreement)
         for n, model in (calibration or {}).items():
             unknown = set(model) - {"intercept", "maps", *REGION_FEATURES}
             if unknown:
@@ -258,11 +301,60 @@ class RatioClassifier:
         self.calibration_ = dict(calibration or {})
         self.provenance_ = dict(provenance or {})
         self.pooling = pooling
+        self.vetoed_: dict[int, tuple[int, ...]] = {}
+
+    # -- the agreement gate ----------------------------------------------------------------
+    @property
+    def gated(self) -> bool:
+        """Whether some dimension's count is gated by cross-window cycle agreement."""
+        return any(th.agreement is not None for th in self.thresholds_.values())
+
+    def _candidates(self, windows: Sequence[Diagram]) -> np.ndarray:
+        """0-based ranks k < agreement.BARS of dimension 1 that pass the score test (S_k > ln tau_1)."""
+        th = self.thresholds_.get(1)
+        if th is None or th.agreement is None or windows[0].maxdim < 1:
+            return np.empty(0, np.int64)
+        scores = pooled_scores(windows, 1, th.q)[:BARS]
+        return np.flatnonzero(scores > np.log(th.tau))
+
+    def needs_agreement(self, windows: Sequence[Diagram]) -> bool:
+        """Whether the region's vote depends on its A_k: gated, and some rank k <= BARS passes."""
+        return len(self._candidates(windows)) > 0
+
+    def with_agreement(self, windows: Sequence[Diagram], agreement: np.ndarray | None) -> "RatioClassifier":
+        """This classifier for one region: its passing ranks with A_k <= b vetoed (module docstring).
+
+        ``agreement`` is the region's A_1 .. A_BARS (:func:`swarmtopo.agreement.rank_agreement`;
+        NaN: no two windows overlap, nothing vetoed); None only if :meth:`needs_agreement` is False.
+        """
+        candidates = self._candidates(windows)
+        view = copy.copy(self)
+        view.vetoed_ = {}
+        if len(candidates):
+            if agreement is None:
+                raise SwarmtopoError("this region's vote needs its cross-window cycle agreement, which was not "
+                                     "computed (maps stored by an earlier swarmtopo: rerun them)")
+            b = self.thresholds_[1].agreement
+            view.vetoed_ = {1: tuple(int(k) for k in candidates if agreement[k] <= b)}
+        return view
+
+    def scores(self, diagram: Diagram, n: int) -> np.ndarray:
+        """The window's decreasing dim-n scores (:func:`window_scores`) without the vetoed ranks."""
+        scores = window_scores(diagram, n, self.thresholds_[n].q)
+        return np.delete(scores, [k for k in self.vetoed_.get(n, ()) if k < len(scores)])
+
+    def score_matrix(self, windows: Sequence[Diagram], n: int) -> np.ndarray:
+        """(W, K) scores of the windows (:func:`score_matrix`) without the vetoed ranks."""
+        return _padded([self.scores(d, n) for d in windows])
+
+    def counted_bars(self, diagram: Diagram, n: int, count: int) -> np.ndarray:
+        """Indices into ``diagram[n]`` of the bars counted in a window: its ``count`` longest not vetoed."""
+        return longest_bars(diagram, n, count, self.vetoed_.get(n, ()))
 
     # -- one window --------------------------------------------------------------------
     def betti(self, diagram: Diagram) -> dict[int, int]:
         """The window's own beta_hat_n, for n up to the diagram's maxdim."""
-        return {n: count_above(window_scores(diagram, n, th.q), th.tau)
+        return {n: count_above(self.scores(diagram, n), th.tau)
                 for n, th in self.thresholds_.items() if n <= diagram.maxdim}
 
     def length_thresholds(self, diagram: Diagram) -> dict[int, float]:
@@ -272,8 +364,7 @@ class RatioClassifier:
 
     def margin(self, diagram: Diagram, n: int) -> float:
         """How far the window's own count in dimension n is from changing (:func:`score_margin`)."""
-        th = self.thresholds_[n]
-        return score_margin(window_scores(diagram, n, th.q), th.tau)
+        return score_margin(self.scores(diagram, n), self.thresholds_[n].tau)
 
     # -- a region: several windows --------------------------------------------------------
     def pooled_betti(self, windows: Sequence[Diagram]) -> dict[int, int]:
@@ -282,7 +373,7 @@ class RatioClassifier:
         maxdim = windows[0].maxdim
         if self.pooling == "median":
             return {n: median_vote([self.betti(d)[n] for d in windows]) for n in self.thresholds_ if n <= maxdim}
-        return {n: count_above(pooled_scores(windows, n, th.q), th.tau)
+        return {n: count_above(self.score_matrix(windows, n).mean(axis=0), th.tau)
                 for n, th in self.thresholds_.items() if n <= maxdim}
 
     def region_features(self, windows: Sequence[Diagram], n: int, voted=None) -> dict[str, float]:
@@ -291,7 +382,7 @@ class RatioClassifier:
         ``voted`` is :func:`vote`'s result for these windows when the caller has it."""
         betti, rep, counts = voted or vote(self, windows)
         th = self.thresholds_[n]
-        matrix = score_matrix(windows, n, th.q)
+        matrix = self.score_matrix(windows, n)
         if self.pooling == "median":
             margin = self.margin(windows[rep], n)
         else:
@@ -350,6 +441,9 @@ class RatioClassifier:
             "definition": f"beta_n = {pooled}",
             "pooling": self.pooling,
             "theta": {str(n): th.to_json() for n, th in self.thresholds_.items()},
+            **({"agreement_gate": "a rank whose mean score passes is not counted when its cross-window cycle "
+                "agreement A_k (the correlation of its loop's circular coordinates in overlapping windows, on the "
+                "events they share) is at most theta.1.agreement"} if self.gated else {}),
             "confidence": self._confidence_definition(),
         }
 
@@ -390,8 +484,10 @@ class RatioClassifier:
                                      "of earlier swarmtopo versions, which are no longer applied; refit it "
                                      "(scripts/tune_accuracy.py)", file=source, column=f"thresholds.{n}",
                                      value=gates)
-                thresholds[int(n)] = RatioThresholds(float(t["q"]), float(t["tau"]))
-            pooling = obj.get("pooling", "mean") if obj["format"] == RATIO_FORMAT else "median"
+                gate = t.get("agreement") if obj["format"] == RATIO_FORMAT else None
+                thresholds[int(n)] = RatioThresholds(float(t["q"]), float(t["tau"]),
+                                                     None if gate is None else float(gate))
+            pooling = obj.get("pooling", "mean") if obj["format"] in READ_FORMATS[2:] else "median"
             # "0": earlier files' beta_0 rate; beta_0's confidence is now the pipeline's (swarmtopo.beta0)
             calibration = {n: c for n, c in (obj.get("calibration") or {}).items() if n != "0"}
             return cls(thresholds, calibration or None, obj.get("provenance") or {}, pooling)

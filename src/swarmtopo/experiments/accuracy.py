@@ -37,7 +37,7 @@ from ..arena import HOLE_SHAPES, OUTER_SHAPES
 from ..cycles import wilson_interval
 from ..errors import SwarmtopoError
 from ..persistence import Diagram
-from ..ratio import vote
+from ..ratio import region_reader, vote
 from ..pipeline import MapConfig
 from .grid import Job, canonical_json, case_streams
 from .sweep import build_arena
@@ -227,7 +227,8 @@ def outcomes(rows, classifier) -> list[dict[str, Any]]:
     confidences, and whether (beta_0, beta_1) is exactly right.
 
     beta_1 and its confidence are read from the row's stored per-window diagrams by
-    ``classifier`` (each region's windows voted as in the pipeline), so the table is
+    ``classifier`` (each region's windows voted as in the pipeline, with its stored A_k
+    if the classifier gates by agreement), so the table is
     the given classifier's verdict on the stored maps: the shipped one's, whatever
     classifier ran the job.  beta_0 and its confidence are the job's (graph components,
     :mod:`swarmtopo.beta0`).  A failed job
@@ -239,9 +240,12 @@ def outcomes(rows, classifier) -> list[dict[str, Any]]:
         est0, est1, conf0, conf1 = row["est_betti0"], None, None, None
         if row["error"] is None:
             regions = [[Diagram.from_json(w["diagram"]) for w in r["windows"]] for r in row["diagrams"]]
-            votes = [vote(classifier, windows) for windows in regions]
+            readers = [region_reader(classifier, windows, r.get("agreement"))
+                       for windows, r in zip(regions, row["diagrams"])]
+            votes = [vote(reader, windows) for reader, windows in zip(readers, regions)]
             est1 = sum(voted[0].get(1, 0) for voted in votes)
-            confs = [classifier.region_confidence(windows, voted).get(1) for windows, voted in zip(regions, votes)]
+            confs = [reader.region_confidence(windows, voted).get(1)
+                     for reader, windows, voted in zip(readers, regions, votes)]
             conf1 = None if None in confs else float(np.prod(confs))
             conf0 = row["confidence_betti0"]
         right = row["error"] is None and est0 == row["true_betti0"] and est1 == row["true_betti1"]

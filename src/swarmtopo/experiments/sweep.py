@@ -37,7 +37,8 @@ from ..errors import SwarmtopoError
 from ..io import GROUND_TRUTH_META_KEYS, read_arena, read_log, write_log
 from ..log import EncounterLog
 from ..persistence import snr
-from ..pipeline import MapConfig, map_encounters, seconds_option, software_versions, wall_follow_option
+from ..pipeline import (MapConfig, agreement_json, map_encounters, seconds_option, software_versions,
+                        wall_follow_option)
 from ..sim import simulate
 from .grid import Job, flat_columns
 from .store import JOB_COLUMNS, ResultStore
@@ -127,7 +128,8 @@ def job_map_config(mapping: dict[str, Any], seed: int | None = None) -> MapConfi
     """The ``MapConfig`` of a job's canonical ``[map]`` table ("auto" -> None, from the
     data; "none" -> inf, except a "none" wall-following weight -> None), as sweeps map:
     no picture, no loops; every other option is ``swarmtopo map``'s default, the window
-    cap ``max_windows`` included (not a grid key: no map of the accuracy suite reaches it)."""
+    cap ``max_windows`` included (not a grid key: no map of the accuracy suite reaches it), and
+    ``agreement`` ("auto" unless the table says, as the gate's fitting jobs do)."""
     return MapConfig(
         metric=mapping["metric"], subsample=mapping["subsample"],
         hop_cost=seconds_option(mapping["hop_cost"]),
@@ -139,7 +141,8 @@ def job_map_config(mapping: dict[str, Any], seed: int | None = None) -> MapConfi
         window_step=seconds_option(mapping.get("window_step")),
         landmarks=None if mapping["landmarks"] == "auto" else mapping["landmarks"],
         max_landmarks=mapping.get("max_landmarks", MapConfig.max_landmarks),
-        maxdim=mapping["maxdim"], seed=seed, embed_dim=0, cycles=False)
+        maxdim=mapping["maxdim"], seed=seed, embed_dim=0, cycles=False,
+        agreement=mapping.get("agreement", MapConfig.agreement))
 
 
 def run_job(job: Job) -> dict[str, Any]:
@@ -187,7 +190,7 @@ def run_job(job: Job) -> dict[str, Any]:
             snr_h1=ratio.ratio, noise_power_h1=ratio.noise_power,
             lengths_h1=[float(x) for x in tmap.diagram.lengths(1)],
             diagrams=[{"events": r.n_events, "agents": r.n_agents, "landmarks": len(r.landmarks.nodes),
-                       "diagram": r.diagram.to_json(), "window": r.window,
+                       "diagram": r.diagram.to_json(), "window": r.window, "agreement": agreement_json(r.agreement),
                        "windows": [{**w.to_json(), "diagram": w.diagram.to_json()} for w in r.windows]}
                       for r in tmap.regions],
             n_regions=len(tmap.regions),

@@ -8,6 +8,10 @@ only which bars count, so no job is rerun -- for each way of pooling the windows
 a cross-validated count beside the fitted one (:func:`cross_validated`).  The
 confidence model of the chosen candidate is then fitted on the same tuning maps,
 cross-fitted (:func:`calibrated_classifier`, :func:`cross_fitted_features`).
+
+``scripts/fit_agreement_gate.py`` then adds the agreement gate to the default classifier
+(:func:`fit_gate`: the score threshold a = ln tau_1 and the agreement threshold b, on
+tuning maps whose rows hold every region's A_k) and refits its confidence the same way.
 """
 
 from __future__ import annotations
@@ -16,14 +20,18 @@ from dataclasses import dataclass
 from typing import Any, Sequence
 
 import numpy as np
-from scipy.ndimage import uniform_filter1d
+from scipy.ndimage import uniform_filter, uniform_filter1d
 
 from ..persistence import Diagram
-from ..ratio import RatioClassifier, RatioThresholds, pooled_scores, window_scores
+from ..agreement import BARS
+from ..ratio import RatioClassifier, RatioThresholds, pooled_scores, region_reader, window_scores
 
 Q_GRID = (0.5, 0.6, 0.7, 0.8, 0.9)
 TAU_GRID = tuple(np.round(np.geomspace(1.2, 12.0, 80), 4))
 """The (q_1, tau_1) grid."""
+A_GRID = tuple(np.round(np.arange(1.60, 2.2001, 0.02), 2))
+B_GRID = tuple(np.round(np.arange(0.0, 0.9601, 0.02), 2))
+"""The agreement gate's grid: score threshold a = ln tau_1 and agreement threshold b."""
 PIPELINE_FIELDS = ("metric", "hop_cost", "diffusion_time", "wall_follow_weight", "window_length",
                    "window_encounters", "window_scales", "window_step")
 """The MapConfig fields the candidate pipelines of ``scripts/tune_accuracy.py`` set: the
@@ -39,6 +47,7 @@ class TuningMap:
     true_betti0: int
     true_betti1: int
     cell: str
+    agreement: tuple[np.ndarray | None, ...] = ()  # each region's A_1 .. A_BARS, None where not computed
 
 
 def maps_from_rows(rows: Sequence[dict[str, Any]], cell_of) -> list[TuningMap]:
@@ -53,18 +62,27 @@ def maps_from_rows(rows: Sequence[dict[str, Any]], cell_of) -> list[TuningMap]:
         regions = tuple(
             tuple(Diagram.from_json(w["diagram"]) for w in region["windows"])
             for region in row["diagrams"])
+        agreement = tuple(None if region.get("agreement") is None else
+                          np.array([np.nan if a is None else a for a in region["agreement"]], dtype=float)
+                          for region in row["diagrams"])
         maps.append(TuningMap(regions, int(row["est_betti0"]), int(row["true_betti0"]), int(row["true_betti1"]),
-                              cell_of(row["config"])))
+                              cell_of(row["config"]), agreement))
     return maps
 
 
 def exact(maps: Sequence[TuningMap], th: RatioThresholds, pooling: str = "mean") -> np.ndarray:
-    """Whether each map's (beta_0, beta_1) is exactly right under thresholds ``th``, its
-    regions' windows pooled by ``pooling`` (the literal classifier)."""
+    """Whether each map's (beta_0, beta_1) is exactly right under thresholds ``th`` (gated
+    by agreement if ``th.agreement`` is set), its regions' windows pooled by ``pooling``
+    (the literal classifier)."""
     model = RatioClassifier({1: th}, pooling=pooling)
     return np.array([m.est_betti0 == m.true_betti0 and
-                     sum(model.pooled_betti(region)[1] for region in m.regions) == m.true_betti1
-                     for m in maps])
+                     sum(_reader(model, m, r).pooled_betti(region)[1] for r, region in enumerate(m.regions))
+                     == m.true_betti1 for m in maps])
+
+
+def _reader(model: RatioClassifier, m: TuningMap, r: int) -> RatioClassifier:
+    """``model`` as it reads region r of map m (:func:`~swarmtopo.ratio.region_reader`)."""
+    return region_reader(model, m.regions[r], m.agreement[r] if len(m.agreement) > r else None)
 
 
 @dataclass(frozen=True)
@@ -131,8 +149,39 @@ def cross_validated(maps: Sequence[TuningMap], pooling: str = "mean", folds: int
     return int(cross_validated_exact(maps, pooling, folds).sum())
 
 
+def gate_estimates(maps: Sequence[TuningMap], q: float) -> np.ndarray:
+    """beta_hat_1 of every map at every (a, b) of the gate's grid, ``(len(maps), len(A_GRID), len(B_GRID))``:
+    #{k : S_k > a} minus the ranks k <= BARS among them with A_k <= b (NaN A_k vetoes nothing)."""
+    a = np.array(A_GRID)[:, None, None]
+    b = np.array(B_GRID)[None, :, None]
+    est = np.zeros((len(maps), len(A_GRID), len(B_GRID)), np.int64)
+    for k, m in enumerate(maps):
+        for r, region in enumerate(m.regions):
+            scores = pooled_scores(region, 1, q)
+            est[k] += (scores[None, :] > a[:, :, 0]).sum(axis=1)[:, None]
+            agreement = m.agreement[r] if len(m.agreement) > r else None
+            if agreement is None:
+                if (scores[:BARS] > A_GRID[0]).any():
+                    raise ValueError("a tuning map without A_k: fit the gate on maps mapped with agreement='always'")
+                continue
+            top = np.r_[scores[:BARS], np.zeros(BARS)][:BARS][None, None, :]
+            est[k] -= ((top > a) & (agreement[None, None, :] <= b)).sum(axis=2)
+    return est
+
+
+def fit_gate(maps: Sequence[TuningMap], q: float) -> RatioThresholds:
+    """The gate (tau_1 = e^a, b) at the grid point whose mean exact rate over itself and
+    its neighbours in a and b (3 x 3, edges repeated) is highest (ties: the first)."""
+    truth = np.array([m.true_betti1 for m in maps])
+    beta0 = np.array([m.est_betti0 == m.true_betti0 for m in maps])
+    surface = ((gate_estimates(maps, q) == truth[:, None, None]) & beta0[:, None, None]).mean(axis=0)
+    smooth = uniform_filter(surface, size=3, mode="nearest")
+    i, j = np.unravel_index(int(np.argmax(smooth + 1e-9 * surface)), surface.shape)
+    return RatioThresholds(q, round(float(np.exp(A_GRID[i])), 4), float(B_GRID[j]))
+
+
 def cross_fitted_features(maps: Sequence[TuningMap], pooling: str = "mean",
-                          folds: int = 5) -> tuple[list[dict[str, float]], list[bool]]:
+                          folds: int = 5, refit=None) -> tuple[list[dict[str, float]], list[bool]]:
     """Confidence features and outcomes of the one-region maps, each read with thresholds
     fitted without it.
 
@@ -140,28 +189,32 @@ def cross_fitted_features(maps: Sequence[TuningMap], pooling: str = "mean",
     map has one region: the truth is per map) are split into ``folds`` by position;
     for each fold the thresholds are refitted on the other folds, and the fold's
     regions get their :meth:`~swarmtopo.ratio.RatioClassifier.region_features` and
-    whether their beta_1 is right from that refit.
+    whether their beta_1 is right from that refit.  ``refit(maps) -> RatioThresholds``
+    (default: :func:`fit_thresholds` with ``pooling``) is how the thresholds are refitted.
     """
+    refit = refit or (lambda subset: fit_thresholds(subset, pooling).thresholds)
     single = [m for m in maps if m.true_betti0 == 1 and m.est_betti0 == 1]
     fold = np.arange(len(single)) % folds
     features, correct = [], []
     for k in range(folds):
         held = [m for m, f in zip(single, fold) if f == k]
-        th = fit_thresholds([m for m, f in zip(single, fold) if f != k], pooling).thresholds
-        refit = RatioClassifier({1: th}, pooling=pooling)
-        features += [refit.region_features(m.regions[0], 1) for m in held]
+        th = refit([m for m, f in zip(single, fold) if f != k])
+        model = RatioClassifier({1: th}, pooling=pooling)
+        features += [_reader(model, m, 0).region_features(m.regions[0], 1) for m in held]
         correct += [bool(ok) for ok in exact(held, th, pooling)]
     return features, correct
 
 
-def calibrated_classifier(maps: Sequence[TuningMap], fit: Fit, provenance: dict, folds: int = 5) -> RatioClassifier:
+def calibrated_classifier(maps: Sequence[TuningMap], fit: Fit, provenance: dict, folds: int = 5,
+                          refit=None) -> RatioClassifier:
     """The fitted classifier with its confidence calibrated by cross-fitting.
 
     The thresholds were chosen on these very maps, so their outcomes under them are
     optimistic.  The logistic model is fitted on out-of-fold features and outcomes
-    (:func:`cross_fitted_features`) and then used with the final thresholds;
+    (:func:`cross_fitted_features`, thresholds refitted by ``refit``) and then used with
+    the final thresholds.
     """
-    features, correct = cross_fitted_features(maps, fit.pooling, folds)
+    features, correct = cross_fitted_features(maps, fit.pooling, folds, refit)
     model = RatioClassifier({1: fit.thresholds}, provenance={**provenance, "calibration": f"{folds}-fold cross-fitted"},
                             pooling=fit.pooling)
     return model.calibrate(features, correct)

@@ -1,0 +1,103 @@
+"""Fit the default classifier's agreement gate and refit its confidence on the benchmark's tuning cases.
+
+``scripts/tune_accuracy.py`` fits the default classifier's score threshold (q_1, tau_1)
+on stored per-window diagrams.  The gate (:mod:`swarmtopo.ratio`, "Agreement gate")
+also needs each region's cross-window cycle agreement A_k, which those rows do not
+hold, so this script runs its own tuning jobs (``swarmtopo.experiments.accuracy.tuning_jobs``
+inside ``tuning_session``: tuning seeds only, never the held-out hole family): the
+default pipeline with ``agreement = "always"`` (every region's A_1 .. A_5 stored), on
+Dask with a resumable store, ``--sparse-per-cell`` cases of each cell of the smallest
+budget (where the score alone is least sure) and ``--per-cell`` of every other cell.
+
+On those maps, with q_1 the default classifier's, it fits (a = ln tau_1, b) on a grid
+(``experiments.tuning.fit_gate``: the best 3 x 3 neighbourhood mean), prints the
+exact count per cell against the score-only rule (tune_accuracy's tau_1, kept in the
+file's provenance as ``score_only``) and the 4-fold cross-validated count, refits the
+confidence model on the same maps cross-fitted (gate refitted without each fold), and
+writes ``src/swarmtopo/data/classifier-default.json`` with the gate.  Rerun it after
+``tune_accuracy.py``, which writes the score-only classifier.  Contact traces keep
+their score-only classifier (the gate was fitted on log folders only).
+
+Usage::
+
+    python scripts/fit_agreement_gate.py [--store gate.duckdb] [--per-cell 24] [--sparse-per-cell 96] [--workers N]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from swarmtopo import __version__
+from swarmtopo.classify import load_classifier
+from swarmtopo.experiments.accuracy import CELLS, PIPELINES, cell_of, tuning_jobs, tuning_session
+from swarmtopo.experiments.store import read_jobs
+from swarmtopo.experiments.sweep import run_sweep
+from swarmtopo.experiments.tuning import Fit, calibrated_classifier, exact, fit_gate, maps_from_rows
+from swarmtopo.ratio import RatioThresholds
+
+ROOT = Path(__file__).resolve().parent.parent
+TARGET = ROOT / "src" / "swarmtopo" / "data" / "classifier-default.json"
+FOLDS = 4
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--store", default="gate.duckdb")
+    parser.add_argument("--per-cell", type=int, default=24)
+    parser.add_argument("--sparse-per-cell", type=int, default=96)
+    parser.add_argument("--workers", type=int, default=None)
+    parser.add_argument("--scheduler", default=None)
+    args = parser.parse_args()
+    started = time.perf_counter()
+    shipped = load_classifier("default")
+    score_only = RatioThresholds(**shipped.provenance_.get("score_only", {"q": shipped.thresholds_[1].q,
+                                                                          "tau": shipped.thresholds_[1].tau}))
+    pipeline = {**PIPELINES["default"], "classifier": "paper-form", "agreement": "always"}
+    sparse = min(c.agents for c in CELLS)
+    with tuning_session():
+        jobs = list({j.key: j for j in
+                     tuning_jobs({"gate": pipeline}, args.sparse_per_cell, [c for c in CELLS if c.agents == sparse])
+                     + tuning_jobs({"gate": pipeline}, args.per_cell, [c for c in CELLS if c.agents != sparse])
+                     }.values())
+        summary = run_sweep(jobs, args.store, scheduler=args.scheduler, workers=args.workers,
+                            progress=lambda done, total, failed: print(f"\r{done}/{total} jobs", end="", flush=True))
+    print(f"\n{summary}")
+    keys = {j.key for j in jobs}
+    rows = [r for r in read_jobs(args.store) if r["key"] in keys]
+    maps = maps_from_rows(rows, cell_of)
+    gate = fit_gate(maps, score_only.q)
+    before, after = exact(maps, score_only), exact(maps, gate)
+    print(f"{len(maps)} tuning maps ({len(rows) - len(maps)} refused); score only (q {score_only.q:g}, tau "
+          f"{score_only.tau:g}, a = {np.log(score_only.tau):.3f}): {before.sum()}; gate a = {np.log(gate.tau):.2f} "
+          f"(tau {gate.tau:g}), b = {gate.agreement:g}: {after.sum()} ({np.sum(after & ~before)} fixed, "
+          f"{np.sum(before & ~after)} broken)")
+    fold = np.arange(len(maps)) % FOLDS
+    cv = np.zeros(len(maps), bool)
+    for k in range(FOLDS):
+        held = np.flatnonzero(fold == k)
+        cv[held] = exact([maps[i] for i in held], fit_gate([m for m, f in zip(maps, fold) if f != k], score_only.q))
+    print(f"{FOLDS}-fold cross-validated (gate refitted without each fold): {cv.sum()}/{len(maps)}")
+    for cell in CELLS:
+        inside = np.array([m.cell == cell.name for m in maps])
+        print(f"  {cell.name}: score only {before[inside].sum()}/{inside.sum()}, gate {after[inside].sum()}, "
+              f"cross-validated {cv[inside].sum()}")
+    provenance = {**shipped.provenance_, "score_only": {"q": score_only.q, "tau": score_only.tau},
+                  "gate": {"script": "scripts/fit_agreement_gate.py", "per_cell": args.per_cell,
+                           "sparse_per_cell": args.sparse_per_cell, "tuning_maps": len(maps),
+                           "tuning_exact": float(after.mean()), "score_only_exact": float(before.mean()),
+                           "cross_validated_exact": float(cv.mean())},
+                  "swarmtopo": __version__}
+    fitted = Fit(thresholds=gate, accuracy=float(after.mean()), surface=np.empty(0), pooling="mean")
+    model = calibrated_classifier(maps, fitted, provenance, refit=lambda subset: fit_gate(subset, score_only.q))
+    model.save(TARGET)
+    print(f"confidence: {json.dumps(model.calibration_['1'])}")
+    print(f"wrote {TARGET.relative_to(ROOT)} in {(time.perf_counter() - started) / 60:.1f} min")
+
+
+if __name__ == "__main__":
+    main()
