@@ -7,8 +7,7 @@ embed_dim=0)`` for the three subsamplers, on the plain and the hybrid metric (th
 pipeline's default); every other option is the default, so the windows mapped are at
 most ``MapConfig.max_windows`` (``--max-windows none``: every window).  One run each, after a warm-up that loads the numba kernels.
 Wall time split as ``TopologicalMap.timings`` reports it (graph incl. components /
-landmarks incl. the Betti rule's k-NN scale / persistence / agreement, the default
-classifier's cross-window cycle agreement where its gate needs it; "other" is the rest:
+landmarks incl. the Betti rule's k-NN scale / persistence; "other" is the rest:
 region bookkeeping, Betti rule), total
 wall and CPU time, and peak memory: the process's peak RSS above its RSS before the
 call (``_measure.run_measured``), the log itself not counted.  Targets: maxmin < 60 s
@@ -66,19 +65,19 @@ def whole_map(n_events, subsamplers=SUBSAMPLERS, max_windows=MapConfig.max_windo
     log = simulated_log(n_events)
     print(f"\n## map_encounters at {log.n_events:,} events ({log.n_agents} agents, {log.duration:.0f} s, "
           f"{len(log.static_agent)} static, 2 holes), L = {N_LANDMARKS}, H0 + H1, one run each\n")
-    print("| metric | subsample | windows | graph s | landmarks s | persistence s | agreement s | other s | total s | "
-          "CPU s | peak MB above baseline | beta_0, beta_1 | target | met |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("| metric | subsample | windows | graph s | landmarks s | persistence s | other s | total s | CPU s | "
+          "peak MB above baseline | beta_0, beta_1 | target | met |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for metric in METRICS:
         for subsample in subsamplers:
             result, wall, peak, cpu = run_measured(lambda: map_encounters(log, config(metric, subsample, max_windows)))
             stage = result.timings
-            other = wall - stage["graph"] - stage["landmarks"] - stage["persistence"] - stage["agreement"]
+            other = wall - stage["graph"] - stage["landmarks"] - stage["persistence"]
             limit = TIME_LIMIT[subsample]
             met = wall < limit and peak < MEMORY_LIMIT
             windows = sum(len(r.windows) for r in result.regions)
             print(f"| {metric} | {subsample} | {windows} of {windows + result.windows_left_out} | {stage['graph']:.2f} | {stage['landmarks']:.2f} | "
-                  f"{stage['persistence']:.2f} | {stage['agreement']:.2f} | {other:.2f} | {wall:.1f} | {cpu:.1f} | {peak / 2**20:.0f} | "
+                  f"{stage['persistence']:.2f} | {other:.2f} | {wall:.1f} | {cpu:.1f} | {peak / 2**20:.0f} | "
                   f"{result.betti[0]}, {result.betti[1]} | < {limit:.0f} s, < 4 GB | {'yes' if met else 'NO'} |",
                   flush=True)
             del result

@@ -1,4 +1,4 @@
-"""Fit the default classifier's agreement gate and refit its confidence on the benchmark's tuning cases.
+"""Fit the ``gated`` classifier (the default gated by cross-window cycle agreement) on the benchmark's tuning cases.
 
 ``scripts/tune_accuracy.py`` fits the default classifier's score threshold (q_1, tau_1)
 on stored per-window diagrams.  The gate (:mod:`swarmtopo.ratio`, "Agreement gate")
@@ -11,16 +11,19 @@ budget (where the score alone is least sure) and ``--per-cell`` of every other c
 
 On those maps, with q_1 the default classifier's, it fits (a = ln tau_1, b) on a grid
 (``experiments.tuning.fit_gate``: the best 3 x 3 neighbourhood mean), prints the
-exact count per cell against the score-only rule (tune_accuracy's tau_1, kept in the
-file's provenance as ``score_only``) and the 4-fold cross-validated count, refits the
+exact count per cell against the default's score-only rule (its tau_1, kept in the
+file's provenance as ``score_only``) and the 4-fold cross-validated count, fits the
 confidence model on the same maps cross-fitted (gate refitted without each fold), and
-writes ``src/swarmtopo/data/classifier-default.json`` with the gate.  Rerun it after
-``tune_accuracy.py``, which writes the score-only classifier.  Contact traces keep
-their score-only classifier (the gate was fitted on log folders only).
+writes ``src/swarmtopo/data/classifier-gated.json`` (the ``gated`` preset).  Measured,
+it is not better than the default, which stays score-only (docs/accuracy.md).
+
+``--rule A [B]`` (repeatable) also prints, per cell, the count of a fixed rule: S_k > A
+(and A_k > B) on the same maps, without writing anything for it.
 
 Usage::
 
     python scripts/fit_agreement_gate.py [--store gate.duckdb] [--per-cell 24] [--sparse-per-cell 96] [--workers N]
+                                         [--rule 1.84 0.72 --rule 1.84]
 """
 
 from __future__ import annotations
@@ -41,7 +44,7 @@ from swarmtopo.experiments.tuning import Fit, calibrated_classifier, exact, fit_
 from swarmtopo.ratio import RatioThresholds
 
 ROOT = Path(__file__).resolve().parent.parent
-TARGET = ROOT / "src" / "swarmtopo" / "data" / "classifier-default.json"
+TARGET = ROOT / "src" / "swarmtopo" / "data" / "classifier-gated.json"
 FOLDS = 4
 
 
@@ -52,11 +55,14 @@ def main() -> None:
     parser.add_argument("--sparse-per-cell", type=int, default=96)
     parser.add_argument("--workers", type=int, default=None)
     parser.add_argument("--scheduler", default=None)
+    parser.add_argument("--rule", nargs="+", type=float, action="append", default=[], metavar="A [B]",
+                        help="also print the per-cell counts of the rule S_k > A (and A_k > B)")
     args = parser.parse_args()
+    if any(len(rule) > 2 for rule in args.rule):
+        parser.error("--rule takes A, or A and B")
     started = time.perf_counter()
     shipped = load_classifier("default")
-    score_only = RatioThresholds(**shipped.provenance_.get("score_only", {"q": shipped.thresholds_[1].q,
-                                                                          "tau": shipped.thresholds_[1].tau}))
+    score_only = RatioThresholds(shipped.thresholds_[1].q, shipped.thresholds_[1].tau)
     pipeline = {**PIPELINES["default"], "classifier": "paper-form", "agreement": "always"}
     sparse = min(c.agents for c in CELLS)
     with tuning_session():
@@ -82,11 +88,17 @@ def main() -> None:
         held = np.flatnonzero(fold == k)
         cv[held] = exact([maps[i] for i in held], fit_gate([m for m, f in zip(maps, fold) if f != k], score_only.q))
     print(f"{FOLDS}-fold cross-validated (gate refitted without each fold): {cv.sum()}/{len(maps)}")
+    rules = {f"S > {rule[0]:g}" + (f" and A > {rule[1]:g}" if len(rule) == 2 else ""):
+             exact(maps, RatioThresholds(score_only.q, float(np.exp(rule[0])), rule[1] if len(rule) == 2 else None))
+             for rule in args.rule}
     for cell in CELLS:
         inside = np.array([m.cell == cell.name for m in maps])
         print(f"  {cell.name}: score only {before[inside].sum()}/{inside.sum()}, gate {after[inside].sum()}, "
-              f"cross-validated {cv[inside].sum()}")
-    provenance = {**shipped.provenance_, "score_only": {"q": score_only.q, "tau": score_only.tau},
+              f"cross-validated {cv[inside].sum()}"
+              + "".join(f", {label} {right[inside].sum()}" for label, right in rules.items()))
+    for label, right in rules.items():
+        print(f"{label}: {right.sum()}/{len(maps)} ({np.sum(right & ~before)} fixed, {np.sum(before & ~right)} broken)")
+    provenance = {**shipped.provenance_, "name": "gated", "score_only": {"q": score_only.q, "tau": score_only.tau},
                   "gate": {"script": "scripts/fit_agreement_gate.py", "per_cell": args.per_cell,
                            "sparse_per_cell": args.sparse_per_cell, "tuning_maps": len(maps),
                            "tuning_exact": float(after.mean()), "score_only_exact": float(before.mean()),

@@ -9,9 +9,8 @@ or the lower median of the windows' counts) on its stored per-window diagrams, a
 writes
 
 * ``src/swarmtopo/data/classifier-default.json``: the classifier of the ``CHOSEN``
-  candidate and pooling, its confidence calibrated on the tuning maps -- score only:
-  ``scripts/fit_agreement_gate.py``, run next, adds the agreement gate (which needs
-  each region's A_k, not in these rows) and refits the confidence;
+  candidate and pooling, its confidence calibrated on the tuning maps (the ``gated``
+  classifier, ``scripts/fit_agreement_gate.py``, starts from its q_1 and tau_1);
 * ``src/swarmtopo/data/classifier-trace.json``: the same for ``CHOSEN_TRACE``, the
   chosen pipeline reading the tuning cases as contact traces (encounters only), which
   ``map`` uses for a log without status changes;
@@ -137,8 +136,7 @@ def main() -> None:
     _write_doc(results, (CHOSEN, CHOSEN_TRACE), args, time.perf_counter() - started, summary, job_minutes,
                transfer=(default_thresholds, int(transfer.sum()), trace["total"]))
     print(f"chosen: {CHOSEN[0]}, {CHOSEN[1]} pooling; for contact traces: {CHOSEN_TRACE[0]}, {CHOSEN_TRACE[1]} "
-          "pooling; wrote classifier-default.json (score only: now run scripts/fit_agreement_gate.py to add the "
-          "agreement gate), classifier-trace.json and docs/tuning.md")
+          "pooling; wrote classifier-default.json, classifier-trace.json and docs/tuning.md")
 
 
 def _rows(store, jobs):

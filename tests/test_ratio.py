@@ -215,13 +215,15 @@ def test_bad_thresholds_and_files_are_input_errors():
                                    "thresholds": {"1": {"q": 0.5, "tau": 2.0}}})
 
 
-def test_shipped_default_is_a_calibrated_mean_pooled_ratio_classifier_gated_by_agreement():
+def test_shipped_default_is_a_calibrated_mean_pooled_ratio_classifier_and_gated_its_gated_variant():
     model = load_classifier("default")
     assert isinstance(model, RatioClassifier) and model.pooling == "mean"
     assert set(model.calibration_) == {"1"}  # beta_0's confidence is the pipeline's (swarmtopo.beta0)
-    assert model.gated and 0 < model.thresholds_[1].agreement < 1
-    assert model.provenance_["score_only"]["tau"] > 1  # the score-only tau_1 it was fitted from
-    assert not load_classifier("trace").gated  # contact traces: the score alone
+    assert not model.gated and not load_classifier("trace").gated  # the score alone
+    gated = load_classifier("gated")
+    assert gated.gated and 0 < gated.thresholds_[1].agreement < 1 and set(gated.calibration_) == {"1"}
+    assert gated.thresholds_[1].q == model.thresholds_[1].q  # fitted from the default's q_1 and tau_1
+    assert gated.provenance_["score_only"] == model.thresholds_[1].to_json()
 
 
 @pytest.mark.parametrize("key, value, message", [

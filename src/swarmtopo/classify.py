@@ -62,7 +62,7 @@ MAX_MARGIN = 5.0
 """Cap of the log-ratio margin (a bar e^5 ~ 150 times off the threshold is as sure as it gets)."""
 PAPER_THETA = {1: (0.5, 0.7, 3.7)}
 """The paper's published Theta*_1 = (q_1, Delta_1, tau_1), F = 0.03 on its training set."""
-PRESETS = ("default", "trace", "paper", "paper-form")
+PRESETS = ("default", "trace", "gated", "paper", "paper-form")
 """Classifiers shipped with the package (``load_classifier(name)``)."""
 
 Q_GRID = tuple(np.round(np.arange(0.05, 0.951, 0.05), 2))
@@ -411,7 +411,9 @@ def load_classifier(name: str | Path):
     Presets (``PRESETS``): "default", the :class:`~swarmtopo.ratio.RatioClassifier`
     tuned on the accuracy benchmark by ``scripts/tune_accuracy.py``; "trace", the same
     tuned on the benchmark's logs read as contact traces (encounters only), which
-    ``map`` uses for logs without status changes; "paper-form", the
+    ``map`` uses for logs without status changes; "gated", the default with a gate of
+    cross-window cycle agreement, fitted by ``scripts/fit_agreement_gate.py`` (measured,
+    not better: docs/accuracy.md); "paper-form", the
     paper's classifier form trained our way by ``scripts/train_classifier.py``;
     "paper", the paper's published Theta*.  A file may hold either form (its
     ``format`` key says which).

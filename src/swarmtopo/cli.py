@@ -324,12 +324,12 @@ def map_command(
     agreement: str = typer.Option(
         "auto", "--agreement",
         help="When to compute each region's cross-window cycle agreement A_1..A_5 (map.json regions[].agreement: "
-             "is each of the longest loops the same loop in overlapping windows?): auto (default) where the "
-             "default classifier's gate needs it, always for every region, to inspect."),
+             "is each of the longest loops the same loop in overlapping windows?): auto (default) where a gated "
+             "classifier (--classifier gated) needs it, always for every region, to inspect."),
     classifier: Optional[str] = typer.Option(
         None, "--classifier",
         help="Betti classifier: default (tuned on the accuracy benchmark), trace (the same tuned on its logs read "
-             "as contact traces), paper-form (the paper's form trained our way), paper (the paper's Theta*), or a "
+             "as contact traces), gated (the default gated by cross-window cycle agreement), paper-form (the paper's form trained our way), paper (the paper's Theta*), or a "
              "JSON file. Unset: default for a log with status changes, trace for one without."),
     paper: bool = typer.Option(
         False, "--paper",

@@ -333,7 +333,7 @@ class RatioClassifier:
         if len(candidates):
             if agreement is None:
                 raise SwarmtopoError("this region's vote needs its cross-window cycle agreement, which was not "
-                                     "computed (maps stored by an earlier swarmtopo: rerun them)")
+                                     "computed: map it with this classifier, or with agreement 'always'")
             b = self.thresholds_[1].agreement
             view.vetoed_ = {1: tuple(int(k) for k in candidates if agreement[k] <= b)}
         return view
