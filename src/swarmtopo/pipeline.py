@@ -572,14 +572,16 @@ def map_encounters(
                                  diffusion_time=diffusion_time, wall_follow_weight=config.wall_follow_weight)
             window_graphs.append((span, wgraph, wgraph.components()[1]))
     regions: list[RegionMap] = []
+    gated = isinstance(classifier, RatioClassifier) and classifier.gated
+    keep_graphs = gated or config.agreement == "always"  # A_k may be asked for: keep each window's graph
     for comp, n_land in zip(regions_idx, shares):
         region_events = graph.event_index[event_comp == comp]
-        windows, parts = [], []  # the region's windows and the graphs they were mapped on
+        windows, parts = [], []  # the region's windows and (if kept) the graphs they were mapped on
         for span, wgraph, wlabels in window_graphs:
             part = _region_part(wgraph, wlabels, region_events, log, config)
             if part is not None:
                 windows.append(_map_window(span, part, n_land, config, rng, timings, say))
-                parts.append(part)
+                parts.append(part if keep_graphs else None)
         fallback = []
         if not windows:  # no window holds enough of this region: map its whole log instead
             whole = graph.subgraph(np.flatnonzero(labels == comp))
@@ -590,7 +592,6 @@ def map_encounters(
                 fallback = [f"no window ({tried} s long) holds {config.min_region_events} encounters of this region "
                             f"among {MIN_REGION_AGENTS} agents: its whole log was mapped instead"]
         diagrams = [w.diagram for w in windows]
-        gated = isinstance(classifier, RatioClassifier) and classifier.gated
         agreement = None
         if config.agreement == "always" or (gated and classifier.needs_agreement(diagrams)):
             say("agreement")
