@@ -10,9 +10,8 @@ model fitted without it (scikit-learn ``cross_val_predict``, 10 folds by positio
 Prints the Brier score (against a constant confidence equal to the rate) and log loss
 of those predictions, and the reliability table in the bins of the accuracy benchmark.
 
-These are the score-only classifier's maps (tune_accuracy's rows hold no A_k); the
-shipped default's gated confidence is fitted the same way, on z, by
-``scripts/fit_agreement_gate.py``.
+These are the default (score-only) classifier's maps; the ``gated`` preset's confidence
+is fitted the same way, on z, by ``scripts/fit_agreement_gate.py``.
 
 Feature sets: ``z`` (shipped: how many standard errors the pooled scores are from
 changing the vote, ``ratio.standardised_margin``); the previous calibration's

@@ -37,10 +37,12 @@ import numpy as np
 
 from swarmtopo import __version__
 from swarmtopo.classify import load_classifier
-from swarmtopo.experiments.accuracy import CELLS, PIPELINES, cell_of, tuning_jobs, tuning_session
+from swarmtopo.experiments.accuracy import (CELLS, HELD_OUT_FAMILY, PIPELINES, SUITE, cell_of, tuning_jobs,
+                                            tuning_session)
 from swarmtopo.experiments.store import read_jobs
 from swarmtopo.experiments.sweep import run_sweep
-from swarmtopo.experiments.tuning import Fit, calibrated_classifier, exact, fit_gate, maps_from_rows
+from swarmtopo.experiments.tuning import (Fit, calibrated_classifier, cross_validated_exact, exact, fit_gate,
+                                         maps_from_rows)
 from swarmtopo.ratio import RatioThresholds
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -82,12 +84,15 @@ def main() -> None:
           f"{score_only.tau:g}, a = {np.log(score_only.tau):.3f}): {before.sum()}; gate a = {np.log(gate.tau):.2f} "
           f"(tau {gate.tau:g}), b = {gate.agreement:g}: {after.sum()} ({np.sum(after & ~before)} fixed, "
           f"{np.sum(before & ~after)} broken)")
-    fold = np.arange(len(maps)) % FOLDS
-    cv = np.zeros(len(maps), bool)
-    for k in range(FOLDS):
-        held = np.flatnonzero(fold == k)
-        cv[held] = exact([maps[i] for i in held], fit_gate([m for m, f in zip(maps, fold) if f != k], score_only.q))
-    print(f"{FOLDS}-fold cross-validated (gate refitted without each fold): {cv.sum()}/{len(maps)}")
+    chosen = []  # the gate each fold's refit chose
+
+    def refit(subset):
+        chosen.append(fit_gate(subset, score_only.q))
+        return chosen[-1]
+
+    cv = cross_validated_exact(maps, folds=FOLDS, refit=refit)
+    print(f"{FOLDS}-fold cross-validated (gate refitted without each fold): {cv.sum()}/{len(maps)}; the folds chose "
+          + ", ".join(f"({np.log(g.tau):.2f}, {g.agreement:g})" for g in chosen))
     rules = {f"S > {rule[0]:g}" + (f" and A > {rule[1]:g}" if len(rule) == 2 else ""):
              exact(maps, RatioThresholds(score_only.q, float(np.exp(rule[0])), rule[1] if len(rule) == 2 else None))
              for rule in args.rule}
@@ -98,11 +103,12 @@ def main() -> None:
               + "".join(f", {label} {right[inside].sum()}" for label, right in rules.items()))
     for label, right in rules.items():
         print(f"{label}: {right.sum()}/{len(maps)} ({np.sum(right & ~before)} fixed, {np.sum(before & ~right)} broken)")
-    provenance = {**shipped.provenance_, "name": "gated", "score_only": {"q": score_only.q, "tau": score_only.tau},
-                  "gate": {"script": "scripts/fit_agreement_gate.py", "per_cell": args.per_cell,
-                           "sparse_per_cell": args.sparse_per_cell, "tuning_maps": len(maps),
-                           "tuning_exact": float(after.mean()), "score_only_exact": float(before.mean()),
-                           "cross_validated_exact": float(cv.mean())},
+    provenance = {"name": "gated", "script": "scripts/fit_agreement_gate.py", "suite": SUITE,
+                  "pipeline": shipped.provenance_.get("pipeline"), "held_out_family": HELD_OUT_FAMILY,
+                  "score_only": {"q": score_only.q, "tau": score_only.tau},
+                  "tuning_cases_per_cell": args.per_cell, "sparse_tuning_cases_per_cell": args.sparse_per_cell,
+                  "tuning_maps": len(maps), "tuning_exact": float(after.mean()),
+                  "score_only_tuning_exact": float(before.mean()), "cross_validated_exact": float(cv.mean()),
                   "swarmtopo": __version__}
     fitted = Fit(thresholds=gate, accuracy=float(after.mean()), surface=np.empty(0), pooling="mean")
     model = calibrated_classifier(maps, fitted, provenance, refit=lambda subset: fit_gate(subset, score_only.q))

@@ -9,7 +9,7 @@ from swarmtopo.classify import load_classifier
 from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.persistence import Diagram
 from swarmtopo.ratio import (LOG_RATIO_CAP, MAX_MARGIN, SCORE_VAR_PRIOR, Z_CAP, RatioClassifier, RatioThresholds,
-                             longest_bars, median_vote, pooled_scores, score_matrix, score_margin,
+                             longest_bars, median_vote, pooled_scores, region_reader, score_matrix, score_margin,
                              standardised_margin, vote, window_scores)
 
 TH = RatioThresholds(q=0.5, tau=2.0)
@@ -303,3 +303,16 @@ def test_a_gated_classifier_round_trips_and_bad_gates_are_refused(tmp_path):
                                 ({2: GATED}, "mean")):
         with pytest.raises(InputError, match="agreement gate"):
             RatioClassifier(thresholds, pooling=pooling)
+    for bad in (False, "0.5", 1.0, -0.1):  # a file's gate is checked like a constructed one's
+        obj = {**model.to_json(), "thresholds": {"1": {"q": 0.5, "tau": 2.0, "agreement": bad}}}
+        with pytest.raises(InputError, match="agreement gate"):
+            RatioClassifier.from_json(obj, source="g.json")
+
+
+def test_region_reader_reads_a_stored_agreement_list_with_nulls_as_nan():
+    model = RatioClassifier({1: GATED})
+    # as map.json and the sweep store hold it: null where no two windows overlap (nothing vetoed)
+    assert region_reader(model, REGION, [0.9, None, None, None, None]).vetoed_ == {}
+    assert region_reader(model, REGION, [0.9, 0.5, None, 0.1, 0.1]).vetoed_ == {1: (1,)}
+    ungated = RatioClassifier({1: TH})
+    assert region_reader(ungated, REGION, None) is ungated  # a score-only classifier never needs A_k

@@ -99,8 +99,9 @@ def test_cross_fitted_features_read_each_one_region_map_with_thresholds_fitted_w
 
 
 def gated_maps(n, rng):
-    """One-region maps whose true holes agree (A ~ 0.9) and whose one noise loop of score
-    ln 2.4-ln 3.6 over the median (between the grid's a and above some) does not (A ~ 0.4)."""
+    """One-region maps whose true holes agree (A = 0.9) and whose one noise loop, about
+    6.5-7 times the median noise length (score about ln 6.5-7, just above a = 1.84),
+    does not (A = 0.4)."""
     maps = []
     for _ in range(n):
         holes = int(rng.integers(0, 4))
@@ -126,8 +127,12 @@ def test_vectorised_gate_grid_equals_the_literal_gated_classifier():
     est = gate_estimates(maps, 0.5)
     for i in range(0, len(A_GRID), 4):
         for j in range(0, len(B_GRID), 6):
-            literal = exact(maps, RatioThresholds(0.5, float(np.exp(A_GRID[i])), B_GRID[j]))
+            th = RatioThresholds(0.5, float(np.exp(A_GRID[i])), B_GRID[j])
+            literal = exact(maps, th)
             assert np.array_equal(literal, est[:, i, j] == truth), (A_GRID[i], B_GRID[j])
+            model = RatioClassifier({1: th})
+            counts = [model.with_agreement(m.regions[0], m.agreement[0]).pooled_betti(m.regions[0])[1] for m in maps]
+            assert counts == list(est[:, i, j]), (A_GRID[i], B_GRID[j])
 
 
 def test_the_gate_fit_vetoes_the_disagreeing_loop_the_score_alone_counts():

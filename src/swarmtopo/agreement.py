@@ -2,9 +2,10 @@ r"""Cross-window cycle agreement: is a rank's loop the same loop in overlapping 
 
 A region's log is mapped in overlapping time windows (:mod:`swarmtopo.pipeline`).  A
 true hole is the same hole in every window, and consecutive windows share events; a
-noise loop of one window need not be a loop of the next.  The default classifier
-(:class:`~swarmtopo.ratio.RatioClassifier` with an ``agreement`` gate) counts a rank k
-only if its pooled score passes *and* its agreement A_k does.
+noise loop of one window need not be a loop of the next.  A gated classifier
+(:class:`~swarmtopo.ratio.RatioClassifier` with an ``agreement`` threshold: the ``gated``
+preset; the default reads the score alone) counts a rank k only if its pooled score
+passes *and* its agreement A_k does.
 
 Circular coordinates (de Silva, Morozov and Vejdemo-Johansson 2011).  For each of a
 window's ``BARS`` longest H1 bars, its representative cocycle over Z/``PRIME`` (ripser.py)
@@ -24,6 +25,9 @@ and reflection of the circle:
 best a_kj, averaged over the windows it overlaps (0 if the window has fewer than k
 bars); A_k is the mean of that over the region's windows that overlap another.  A
 region with no two overlapping windows has no agreement (NaN: the gate lets it pass).
+
+The least squares run on the Rips 1-skeleton at mid-bar as it is: landmarks in a
+component of it that the cocycle does not touch keep theta = 0.
 """
 
 from __future__ import annotations
@@ -92,7 +96,8 @@ def window_coordinates(distances: np.ndarray, diagram: Diagram, nodes: np.ndarra
     _, _, source = dijkstra(graph.adjacency, indices=nodes, min_only=True, return_predecessors=True)
     landmark_of_node = np.full(graph.n_nodes, -1)
     landmark_of_node[nodes] = np.arange(len(nodes))
-    nearest = landmark_of_node[source[graph.node_of_event]]
+    event_source = source[graph.node_of_event]  # scipy marks a node no landmark reaches with a negative source
+    nearest = np.where(event_source >= 0, landmark_of_node[np.maximum(event_source, 0)], -1)
     reached = nearest >= 0
     events = graph.event_index[reached]
     order = np.argsort(events, kind="stable")
@@ -115,6 +120,11 @@ def overlapping(spans: Sequence[tuple[float, float]], i: int) -> list[int]:
     lo, hi = spans[i]
     return [j for j, (lo2, hi2) in enumerate(spans)
             if j != i and min(hi, hi2) - max(lo, lo2) >= OVERLAP * min(hi - lo, hi2 - lo2)]
+
+
+def agreement_array(values) -> np.ndarray:
+    """A_k as floats from an array or a JSON list (null: NaN)."""
+    return np.array([np.nan if a is None else a for a in values], dtype=float)
 
 
 def rank_agreement(coordinates: Sequence[tuple[np.ndarray, np.ndarray] | None],

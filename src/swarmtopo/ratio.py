@@ -32,8 +32,8 @@ Either way the counted bars of a window drawn for the user are its beta_hat_n lo
 Agreement gate (format /4; mean pooling, dimension 1).  With ``agreement`` b set, a rank
 k <= ``agreement.BARS`` whose pooled score passes (S_k > ln tau_1) is *vetoed* when its
 cross-window cycle agreement A_k (:mod:`swarmtopo.agreement`: is the k-th loop the same
-loop in overlapping windows?) is at most b; a region without A_k (one window) vetoes
-nothing.  A vetoed rank is dropped from every window's score sequence
+loop in overlapping windows?) is at most b; a region without A_k (no two of its
+windows overlap) vetoes nothing.  A vetoed rank is dropped from every window's score sequence
 (:meth:`RatioClassifier.with_agreement`), so beta_hat_1 = #{k : S_k > ln tau_1 and not
 vetoed}, and the windows' own counts, the representative window, the drawn bars and z
 below are those of the sequences without it.
@@ -71,7 +71,7 @@ from sklearn.linear_model import LogisticRegression
 
 from . import __version__
 from ._validate import check_format
-from .agreement import BARS
+from .agreement import BARS, agreement_array
 from .errors import InputError, SwarmtopoError
 from .persistence import Diagram
 
@@ -244,9 +244,7 @@ def region_reader(classifier, windows: Sequence[Diagram], agreement) -> Any:
     null for NaN), None if not computed."""
     if not (isinstance(classifier, RatioClassifier) and classifier.gated):
         return classifier
-    if agreement is not None:
-        agreement = np.array([np.nan if a is None else a for a in agreement], dtype=float)
-    return classifier.with_agreement(windows, agreement)
+    return classifier.with_agreement(windows, None if agreement is None else agreement_array(agreement))
 
 
 class RatioClassifier:
@@ -268,7 +266,7 @@ class RatioClassifier:
     Attributes
     ----------
     vetoed_
-        ``{n: 0-based ranks}`` dropped from every window's scores; empty but on the
+        ``{n: 0-based ranks}`` dropped from every window's scores; empty except on the
         region view :meth:`with_agreement` returns.
     """
 
@@ -335,7 +333,8 @@ class RatioClassifier:
                 raise SwarmtopoError("this region's vote needs its cross-window cycle agreement, which was not "
                                      "computed: map it with this classifier, or with agreement 'always'")
             b = self.thresholds_[1].agreement
-            view.vetoed_ = {1: tuple(int(k) for k in candidates if agreement[k] <= b)}
+            vetoed = tuple(int(k) for k in candidates if agreement[k] <= b)
+            view.vetoed_ = {1: vetoed} if vetoed else {}
         return view
 
     def scores(self, diagram: Diagram, n: int) -> np.ndarray:
@@ -484,9 +483,8 @@ class RatioClassifier:
                                      "of earlier swarmtopo versions, which are no longer applied; refit it "
                                      "(scripts/tune_accuracy.py)", file=source, column=f"thresholds.{n}",
                                      value=gates)
-                gate = t.get("agreement") if obj["format"] == RATIO_FORMAT else None
-                thresholds[int(n)] = RatioThresholds(float(t["q"]), float(t["tau"]),
-                                                     None if gate is None else float(gate))
+                gate = t.get("agreement") if obj["format"] == RATIO_FORMAT else None  # checked by __init__
+                thresholds[int(n)] = RatioThresholds(float(t["q"]), float(t["tau"]), gate)
             pooling = obj.get("pooling", "mean") if obj["format"] in READ_FORMATS[2:] else "median"
             # "0": earlier files' beta_0 rate; beta_0's confidence is now the pipeline's (swarmtopo.beta0)
             calibration = {n: c for n, c in (obj.get("calibration") or {}).items() if n != "0"}

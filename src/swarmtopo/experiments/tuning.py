@@ -9,9 +9,10 @@ a cross-validated count beside the fitted one (:func:`cross_validated`).  The
 confidence model of the chosen candidate is then fitted on the same tuning maps,
 cross-fitted (:func:`calibrated_classifier`, :func:`cross_fitted_features`).
 
-``scripts/fit_agreement_gate.py`` then adds the agreement gate to the default classifier
-(:func:`fit_gate`: the score threshold a = ln tau_1 and the agreement threshold b, on
-tuning maps whose rows hold every region's A_k) and refits its confidence the same way.
+``scripts/fit_agreement_gate.py`` fits the ``gated`` preset from the default's q_1: the
+agreement gate (:func:`fit_gate`: the score threshold a = ln tau_1 and the agreement
+threshold b, on tuning maps whose rows hold every region's A_k) and its confidence the
+same way.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ import numpy as np
 from scipy.ndimage import uniform_filter, uniform_filter1d
 
 from ..persistence import Diagram
-from ..agreement import BARS
+from ..agreement import BARS, agreement_array
 from ..ratio import RatioClassifier, RatioThresholds, pooled_scores, region_reader, window_scores
 
 Q_GRID = (0.5, 0.6, 0.7, 0.8, 0.9)
@@ -62,8 +63,7 @@ def maps_from_rows(rows: Sequence[dict[str, Any]], cell_of) -> list[TuningMap]:
         regions = tuple(
             tuple(Diagram.from_json(w["diagram"]) for w in region["windows"])
             for region in row["diagrams"])
-        agreement = tuple(None if region.get("agreement") is None else
-                          np.array([np.nan if a is None else a for a in region["agreement"]], dtype=float)
+        agreement = tuple(None if region.get("agreement") is None else agreement_array(region["agreement"])
                           for region in row["diagrams"])
         maps.append(TuningMap(regions, int(row["est_betti0"]), int(row["true_betti0"]), int(row["true_betti1"]),
                               cell_of(row["config"]), agreement))
@@ -131,15 +131,17 @@ def fit_thresholds(maps: Sequence[TuningMap], pooling: str = "mean") -> Fit:
                surface=surface, pooling=pooling)
 
 
-def cross_validated_exact(maps: Sequence[TuningMap], pooling: str = "mean", folds: int = 4) -> np.ndarray:
+def cross_validated_exact(maps: Sequence[TuningMap], pooling: str = "mean", folds: int = 4,
+                          refit=None) -> np.ndarray:
     """Whether each map is exactly right when its fold (maps split by position) is read
-    with the thresholds fitted on the other folds."""
+    with the thresholds fitted on the other folds (``refit(maps) -> RatioThresholds``,
+    default :func:`fit_thresholds` with ``pooling``)."""
+    refit = refit or (lambda subset: fit_thresholds(subset, pooling).thresholds)
     fold = np.arange(len(maps)) % folds
     right = np.zeros(len(maps), bool)
     for k in range(folds):
         held = np.flatnonzero(fold == k)
-        th = fit_thresholds([m for m, f in zip(maps, fold) if f != k], pooling).thresholds
-        right[held] = exact([maps[i] for i in held], th, pooling)
+        right[held] = exact([maps[i] for i in held], refit([m for m, f in zip(maps, fold) if f != k]), pooling)
     return right
 
 
@@ -177,7 +179,7 @@ def fit_gate(maps: Sequence[TuningMap], q: float) -> RatioThresholds:
     surface = ((gate_estimates(maps, q) == truth[:, None, None]) & beta0[:, None, None]).mean(axis=0)
     smooth = uniform_filter(surface, size=3, mode="nearest")
     i, j = np.unravel_index(int(np.argmax(smooth + 1e-9 * surface)), surface.shape)
-    return RatioThresholds(q, round(float(np.exp(A_GRID[i])), 4), float(B_GRID[j]))
+    return RatioThresholds(q, float(np.exp(A_GRID[i])), float(B_GRID[j]))
 
 
 def cross_fitted_features(maps: Sequence[TuningMap], pooling: str = "mean",
