@@ -24,17 +24,11 @@ import time
 from swarmtopo.classify import load_classifier
 from swarmtopo.experiments.accuracy import (CELLS, PIPELINES, QUICK_PER_CELL, REPORTING_PER_CELL, accuracy_table,
                                             beta1_misses, most_windows, outcomes, rate_text, reliability, reporting_jobs)
-from swarmtopo.experiments.store import read_jobs
+from swarmtopo.experiments.store import job_rows
 from swarmtopo.experiments.sweep import run_sweep
 
 TRACE = {**PIPELINES["default"], "input": "contact-trace"}
 """The default pipeline reading only the encounters of each case's log folder."""
-
-
-def _rows(store: str, jobs) -> list[dict]:
-    """The store's rows of these jobs."""
-    keys = {job.key for job in jobs}
-    return [row for row in read_jobs(store) if row["key"] in keys]
 
 
 def main() -> None:
@@ -54,11 +48,11 @@ def main() -> None:
     summary = run_sweep(jobs, args.store, workers=args.workers)
     print(f"{len(jobs)} contact-trace maps ({per_cell} per cell), {summary.run} run in "
           f"{(time.perf_counter() - start) / 60:.1f} min on {summary.workers} Dask workers")
-    rows = _rows(args.store, jobs)  # each job's stored diagrams, read by each classifier (whatever the job ran)
+    rows = job_rows(args.store, jobs)  # each job's stored diagrams, read by each classifier (whatever the job ran)
     print(f"at most {most_windows(rows)} windows per region")
     columns = {f"contact trace, {name} classifier": outcomes(rows, load_classifier(name)) for name in args.classifier}
     if args.compare:
-        full = _rows(args.compare, reporting_jobs(per_cell, pipelines={"default": PIPELINES["default"]}))
+        full = job_rows(args.compare, reporting_jobs(per_cell, pipelines={"default": PIPELINES["default"]}))
         columns["full log folder, default classifier (docs/accuracy.md)"] = outcomes(full, load_classifier("default"))
     tables = {name: accuracy_table(records) for name, records in columns.items()}
     print("\n| cell | " + " | ".join(columns) + " |\n|---|" + "---|" * len(columns))

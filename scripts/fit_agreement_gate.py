@@ -39,10 +39,9 @@ from swarmtopo import __version__
 from swarmtopo.classify import load_classifier
 from swarmtopo.experiments.accuracy import (CELLS, HELD_OUT_FAMILY, PIPELINES, SUITE, cell_of, tuning_jobs,
                                             tuning_session)
-from swarmtopo.experiments.store import read_jobs
+from swarmtopo.experiments.store import job_rows
 from swarmtopo.experiments.sweep import run_sweep
-from swarmtopo.experiments.tuning import (Fit, calibrated_classifier, cross_validated_exact, exact, fit_gate,
-                                         maps_from_rows)
+from swarmtopo.experiments.tuning import calibrated_classifier, cross_validated_exact, exact, fit_gate, maps_from_rows
 from swarmtopo.ratio import RatioThresholds
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -75,8 +74,7 @@ def main() -> None:
         summary = run_sweep(jobs, args.store, scheduler=args.scheduler, workers=args.workers,
                             progress=lambda done, total, failed: print(f"\r{done}/{total} jobs", end="", flush=True))
     print(f"\n{summary}")
-    keys = {j.key for j in jobs}
-    rows = [r for r in read_jobs(args.store) if r["key"] in keys]
+    rows = job_rows(args.store, jobs)
     maps = maps_from_rows(rows, cell_of)
     gate = fit_gate(maps, score_only.q)
     before, after = exact(maps, score_only), exact(maps, gate)
@@ -110,8 +108,7 @@ def main() -> None:
                   "tuning_maps": len(maps), "tuning_exact": float(after.mean()),
                   "score_only_tuning_exact": float(before.mean()), "cross_validated_exact": float(cv.mean()),
                   "swarmtopo": __version__}
-    fitted = Fit(thresholds=gate, accuracy=float(after.mean()), surface=np.empty(0), pooling="mean")
-    model = calibrated_classifier(maps, fitted, provenance, refit=lambda subset: fit_gate(subset, score_only.q))
+    model = calibrated_classifier(maps, gate, provenance, refit=lambda subset: fit_gate(subset, score_only.q))
     model.save(TARGET)
     print(f"confidence: {json.dumps(model.calibration_['1'])}")
     print(f"wrote {TARGET.relative_to(ROOT)} in {(time.perf_counter() - started) / 60:.1f} min")

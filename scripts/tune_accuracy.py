@@ -39,7 +39,7 @@ import numpy as np
 
 from swarmtopo import __version__
 from swarmtopo.experiments.accuracy import CELLS, HELD_OUT_FAMILY, SUITE, TUNING_PER_CELL, cell_of, tuning_jobs, tuning_session
-from swarmtopo.experiments.store import read_jobs
+from swarmtopo.experiments.store import job_rows
 from swarmtopo.experiments.sweep import job_map_config, run_sweep
 from swarmtopo.experiments.tuning import (PIPELINE_FIELDS, Q_GRID, TAU_GRID, calibrated_classifier, cross_validated, exact,
                                          fit_thresholds, maps_from_rows)
@@ -99,7 +99,9 @@ def main() -> None:
                             workers=args.workers,
                             progress=lambda done, total, failed: print(f"\r{done}/{total} jobs", end="", flush=True))
         print(f"\n{summary}")
-        rows = {name: _rows(args.store, js) for name, js in jobs.items()}
+        stored = {row["key"]: row for row in job_rows(args.store, [j for js in jobs.values() for j in js])}
+        rows = {name: [stored[j.key] for j in sorted(js, key=lambda j: j.key) if j.key in stored]
+                for name, js in jobs.items()}
         results = {}
         for name, candidate_rows in rows.items():
             maps = maps_from_rows(candidate_rows, cell_of)
@@ -124,10 +126,11 @@ def main() -> None:
         raise SystemExit(f"MapConfig defaults differ from the chosen pipeline: {mismatch}; update swarmtopo/pipeline.py")
     for name, key in (("default", CHOSEN), ("trace", CHOSEN_TRACE)):
         chosen = results[key]
-        model = calibrated_classifier(chosen["maps"], chosen["fit"], provenance={
+        model = calibrated_classifier(chosen["maps"], chosen["fit"].thresholds, provenance={
             "name": name, "script": "scripts/tune_accuracy.py", "suite": SUITE, "pipeline": CANDIDATES[key[0]],
             "tuning_cases_per_cell": args.per_cell, "held_out_family": HELD_OUT_FAMILY,
-            "tuning_maps": chosen["total"], "tuning_exact": chosen["right"] / chosen["total"], "swarmtopo": __version__})
+            "tuning_maps": chosen["total"], "tuning_exact": chosen["right"] / chosen["total"], "swarmtopo": __version__},
+            pooling=chosen["fit"].pooling)
         model.save(ROOT / "src" / "swarmtopo" / "data" / f"classifier-{name}.json")
     job_minutes = sum(r["t_total"] for candidate_rows in rows.values() for r in candidate_rows) / 60
     trace, default_thresholds = results[CHOSEN_TRACE], results[CHOSEN]["fit"].thresholds
@@ -137,11 +140,6 @@ def main() -> None:
                transfer=(default_thresholds, int(transfer.sum()), trace["total"]))
     print(f"chosen: {CHOSEN[0]}, {CHOSEN[1]} pooling; for contact traces: {CHOSEN_TRACE[0]}, {CHOSEN_TRACE[1]} "
           "pooling; wrote classifier-default.json, classifier-trace.json and docs/tuning.md")
-
-
-def _rows(store, jobs):
-    keys = {j.key for j in jobs}
-    return [r for r in read_jobs(store) if r["key"] in keys]
 
 
 def _rate(flags) -> tuple[int, int]:

@@ -63,7 +63,7 @@ def test_vectorised_grid_equals_the_literal_classifier():
 
 def test_cross_fitted_calibration_is_confident_on_clean_maps():
     maps = synthetic_maps(30, np.random.default_rng(1))
-    model = calibrated_classifier(maps, fit_thresholds(maps), provenance={"name": "t"}, folds=3)
+    model = calibrated_classifier(maps, fit_thresholds(maps).thresholds, provenance={"name": "t"}, folds=3)
     assert model.provenance_["calibration"] == "3-fold cross-fitted"
     # every out-of-fold outcome is right: the smoothed rate (30 + 1) / (30 + 2)
     confidence = model.region_confidence(maps[0].regions[0])[1]

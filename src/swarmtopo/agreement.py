@@ -80,19 +80,15 @@ def window_coordinates(distances: np.ndarray, diagram: Diagram, nodes: np.ndarra
     at the last death of the BARS longest bars (bars dying later are left infinite and
     not used): half the time of the whole filtration, the same bars.
     """
-    bars = diagram[1]
-    if not len(bars):
+    if not len(diagram[1]):
         return graph.event_index[:0], np.full((BARS, 0), np.nan)
-    longest = np.argsort(-(bars[:, 1] - bars[:, 0]), kind="stable")[:BARS]
-    stop = float(bars[longest, 1].max())
+    stop = float(diagram[1][_longest(diagram), 1].max())
     result = rips_persistence(distances, maxdim=1, cocycles=True, coefficients=PRIME,
                               threshold=stop if np.isfinite(stop) else np.inf)
-    pairs, cocycles = result.diagram[1], result.cocycles[1]
-    finite = np.flatnonzero(np.isfinite(pairs[:, 1]))
+    pairs = result.diagram[1]
     theta = np.full((BARS, len(distances)), np.nan)
-    order = finite[np.argsort(-(pairs[finite, 1] - pairs[finite, 0]), kind="stable")[:BARS]]
-    for k, i in enumerate(order):
-        theta[k] = circular_coordinates(distances, pairs[i], cocycles[i])
+    for k, i in enumerate(_longest(result.diagram)):
+        theta[k] = circular_coordinates(distances, pairs[i], result.cocycles[1][i])
     _, _, source = dijkstra(graph.adjacency, indices=nodes, min_only=True, return_predecessors=True)
     landmark_of_node = np.full(graph.n_nodes, -1)
     landmark_of_node[nodes] = np.arange(len(nodes))
@@ -102,6 +98,13 @@ def window_coordinates(distances: np.ndarray, diagram: Diagram, nodes: np.ndarra
     events = graph.event_index[reached]
     order = np.argsort(events, kind="stable")
     return events[order], theta[:, nearest[reached]][:, order]
+
+
+def _longest(diagram: Diagram) -> np.ndarray:
+    """Indices of the BARS longest finite H1 bars (ties by position)."""
+    lengths = diagram.lengths(1)
+    finite = np.flatnonzero(np.isfinite(lengths))
+    return finite[np.argsort(-lengths[finite], kind="stable")[:BARS]]
 
 
 def pair_agreement(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
@@ -132,11 +135,15 @@ def rank_agreement(coordinates: Sequence[tuple[np.ndarray, np.ndarray] | None],
     """A_1 .. A_BARS of a region from its windows' coordinates (:func:`window_coordinates`; None
     allowed for a window that overlaps no other) and spans (t0, t1); all NaN when no two
     windows overlap (module docstring)."""
+    pairs = {}  # (i, j), i < j: a_ij of the two windows (a_ji is its transpose)
     per_window = []
     for i in range(len(coordinates)):
         near = overlapping(spans, i)
         if not near:
             continue
-        best = np.mean([pair_agreement(coordinates[i], coordinates[j]).max(axis=1) for j in near], axis=0)
+        for j in near:
+            if (min(i, j), max(i, j)) not in pairs:
+                pairs[min(i, j), max(i, j)] = pair_agreement(coordinates[min(i, j)], coordinates[max(i, j)])
+        best = np.mean([(pairs[i, j] if i < j else pairs[j, i].T).max(axis=1) for j in near], axis=0)
         per_window.append(np.where(np.isnan(coordinates[i][1]).all(axis=1), 0.0, best))
     return np.mean(per_window, axis=0) if per_window else np.full(BARS, np.nan)

@@ -342,14 +342,13 @@ def run_benchmark(store, *, quick: bool = False, scheduler: str | None = None, w
     maps read by the paper's published Theta*.
     """
     from ..classify import load_classifier
-    from .store import read_jobs
+    from .store import job_rows
     from .sweep import run_sweep
 
     per_cell = per_cell or (QUICK_PER_CELL if quick else REPORTING_PER_CELL)
     jobs = reporting_jobs(per_cell, cells=cells)
     summary = run_sweep(jobs, store, scheduler=scheduler, workers=workers, progress=progress)
-    keys = {job.key for job in jobs}
-    rows = [row for row in read_jobs(store) if row["key"] in keys]
+    rows = job_rows(store, jobs)
     by_pipeline = {name: [r for r in rows if _pipeline_of(r["config"]) == name] for name in PIPELINES}
     results = {name: outcomes(subset, load_classifier(PIPELINES[name]["classifier"]))
                for name, subset in by_pipeline.items()}

@@ -177,6 +177,12 @@ def read_jobs(path, sweep: str | None = None, columns: Sequence[str] | None = No
     return rows
 
 
+def job_rows(path, jobs) -> list[dict[str, Any]]:
+    """The stored rows of these jobs (:func:`read_jobs`, every column), sorted by key."""
+    keys = {job.key for job in jobs}
+    return [row for row in read_jobs(path) if row["key"] in keys]
+
+
 def _tables(db) -> set[str]:
     """Which of the store's tables the file holds."""
     return {name for (name,) in db.execute("SELECT table_name FROM information_schema.tables "

@@ -207,16 +207,16 @@ def cross_fitted_features(maps: Sequence[TuningMap], pooling: str = "mean",
     return features, correct
 
 
-def calibrated_classifier(maps: Sequence[TuningMap], fit: Fit, provenance: dict, folds: int = 5,
-                          refit=None) -> RatioClassifier:
-    """The fitted classifier with its confidence calibrated by cross-fitting.
+def calibrated_classifier(maps: Sequence[TuningMap], thresholds: RatioThresholds, provenance: dict,
+                          pooling: str = "mean", folds: int = 5, refit=None) -> RatioClassifier:
+    """The classifier of the fitted ``thresholds`` with its confidence calibrated by cross-fitting.
 
     The thresholds were chosen on these very maps, so their outcomes under them are
     optimistic.  The logistic model is fitted on out-of-fold features and outcomes
     (:func:`cross_fitted_features`, thresholds refitted by ``refit``) and then used with
     the final thresholds.
     """
-    features, correct = cross_fitted_features(maps, fit.pooling, folds, refit)
-    model = RatioClassifier({1: fit.thresholds}, provenance={**provenance, "calibration": f"{folds}-fold cross-fitted"},
-                            pooling=fit.pooling)
+    features, correct = cross_fitted_features(maps, pooling, folds, refit)
+    model = RatioClassifier({1: thresholds}, provenance={**provenance, "calibration": f"{folds}-fold cross-fitted"},
+                            pooling=pooling)
     return model.calibrate(features, correct)
