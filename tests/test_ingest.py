@@ -13,7 +13,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from swarmtopo.errors import InputError
+from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.ingest import ingest
 from swarmtopo.io import read_log, write_log
 
@@ -407,3 +407,61 @@ def test_minus_zero_is_not_the_integer_zero_and_a_folder_is_not_a_trace(tmp_path
     assert sorted(map(str, log.agent_ids)) == ["-0", "0", "1"]
     with pytest.raises(InputError, match="is a folder, not a trace file"):
         ingest(tmp_path, "csv")
+
+
+# -- input the review found mishandled ------------------------------------------------------
+def test_csv_ids_written_with_a_zero_fraction_are_integers(tmp_path):
+    log, _ = ingest(write(tmp_path, "trace.csv", "t,a,b\n1,12.0,3\n2,12,3.00\n3,9007199254740993.0,3\n"), "csv")
+    assert log.agent_ids.tolist() == [3, 12, 9007199254740993]  # exact beyond 2^53
+    log, _ = ingest(write(tmp_path, "text.csv", "t,a,b\n1,12.0,3\n2,12.5,3\n"), "csv")
+    assert log.agent_ids.tolist() == ["12.0", "12.5", "3"]
+
+
+@pytest.mark.parametrize("text, lines, blank", [
+    ("1 C M1 1 2\n", 1, 0),  # a message, no connection
+    ("", 0, 0),
+    ("\n  \n", 2, 2),
+    ("1 CONN 1 2 down\n2 CONN 1 2 down\n", 2, 0),
+])
+def test_a_one_trace_without_an_up_has_no_encounters(tmp_path, text, lines, blank):
+    with pytest.raises(InputError) as caught:
+        ingest(write(tmp_path, "one.txt", text), "one")
+    expected = f"no encounters in the trace ({lines} lines read, 0 skipped as malformed, {blank} blank)"
+    assert caught.value.reason == expected
+
+
+def test_a_gzipped_csv_is_read_by_content_and_binary_csv_is_refused(tmp_path, monkeypatch):
+    path = write(tmp_path, "trace.csv", gzip.compress(b"t,a,b\n1,1,2\n2,2,3\n"), "wb")
+    log, _ = ingest(path, "csv")
+    assert events(log) == [(1.0, "1", "2"), (2.0, "2", "3")]
+    path = write(tmp_path, "sheet.csv", b"PK\x03\x04\x14\x00\x06\x00\x08\x00\x00\x00!\x00", "wb")
+    with pytest.raises(InputError) as caught:
+        ingest(path, "csv", skip_bad=True)
+    assert caught.value.reason.startswith("binary data, not text: line 1 holds a NUL byte")
+    # a line that is not UTF-8 (here also ragged: pyarrow fails to hand it to Python) refuses the file
+    unraisable = []
+    monkeypatch.setattr("sys.unraisablehook", unraisable.append)
+    path = write(tmp_path, "latin1.csv", b"t,a,b\n1,1,2\n2,Jos\xe9\n3,2,3\n", "wb")
+    with pytest.raises(InputError) as caught:
+        ingest(path, "csv", skip_bad=True)
+    assert caught.value.reason == "not UTF-8 text: line 3 holds the byte 0xe9; save the file as UTF-8"
+    assert unraisable == []
+
+
+def test_narrow_float_parquet_times_are_refused_when_they_were_rounded(tmp_path):
+    path = tmp_path / "trace.parquet"
+    times = np.array([1.4e9, 1.4e9 + 20.0, 1.4e9 + 40.0], np.float32)
+    pq.write_table(pa.table({"t": times, "a": ["1", "2", "3"], "b": ["2", "3", "4"]}), path)
+    with pytest.raises(InputError) as caught:
+        ingest(path, "parquet", skip_bad=True)
+    assert (caught.value.row, caught.value.column) == (1, "t")
+    assert caught.value.reason.startswith("a float time column tells times apart only to 128 s")
+    pq.write_table(pa.table({"t": np.array([0.5, 1000.125], np.float32), "a": ["1", "2"], "b": ["2", "3"]}), path)
+    log, _ = ingest(path, "parquet")
+    assert log.t.tolist() == [0.5, 1000.125]
+
+
+def test_one_column_cannot_be_both_time_and_id(tmp_path):
+    path = write(tmp_path, "trace.csv", "id1,id2\n1,2\n")
+    with pytest.raises(SwarmtopoError, match="three different columns"):
+        ingest(path, "csv", time_column="id1", a_column="id1", b_column="id2")

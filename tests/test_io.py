@@ -1,5 +1,6 @@
 """Log folders on disk: round trips, byte stability, located errors, ground-truth stripping."""
 
+import gzip
 import json
 import time
 from dataclasses import replace
@@ -166,8 +167,13 @@ def test_unknown_format():
     ("0,007,8\n1,8,9\n", ["007", "8", "9"]),
     ("0,1,x\n1,2,3\n", ["1", "2", "3", "x"]),
     ("0,1, 2\n1, 2 ,3\n", [1, 2, 3]),
-    ("0,1,2.0\n", ["1", "2.0"]),
     ("0,-1,99999999999999999999\n", ["-1", "99999999999999999999"]),
+    # an integer with a zero fraction (a float column written out) is that integer, exactly
+    ("0,12.0,3\n1,12,4\n", [3, 4, 12]),
+    ("0,9007199254740993.000,-2.0\n", [-2, 9007199254740993]),  # 2^53 + 1: no float rounding
+    ("0,1,2.5\n", ["1", "2.5"]),
+    ("0,017.0,17\n", ["017.0", "17"]),  # 017 is text, so is 017.0
+    ("0,-0.0,1\n", ["-0.0", "1"]),
 ])
 def test_csv_id_kinds(tmp_path, rows, expected):
     (tmp_path / "events.csv").write_text("t,a,b\n" + rows)
@@ -176,7 +182,7 @@ def test_csv_id_kinds(tmp_path, rows, expected):
 
 def test_text_ids_in_status_make_every_id_text(tmp_path):
     (tmp_path / "events.csv").write_text("t,a,b\n0,1,2\n")
-    (tmp_path / "status.csv").write_text("t,agent,state\n0,A,RW\n")
+    (tmp_path / "status.csv").write_text("t,agent,state\n0,A,RW\n0,1,WF\n")
     assert read_log(tmp_path).agent_ids.tolist() == ["1", "2", "A"]
 
 
@@ -276,7 +282,7 @@ def test_unsorted_input_is_sorted(tmp_path):
 def test_ragged_csv_row(tmp_path):
     err = read_error(folder(tmp_path, "t,a,b\n0,1,2\n\n1,2\n"))
     assert err.file == str(tmp_path / "events.csv")
-    assert "row 2: cannot parse CSV (Expected 3 columns, got 2" in str(err)
+    assert (err.row, err.value, err.reason) == (2, "1,2", "cannot parse CSV (expected 3 columns, found 2)")
 
 
 @pytest.mark.parametrize("data, fragment", [
@@ -582,3 +588,85 @@ def test_log_files_that_are_folders_and_odd_meta_keys_are_refused(tmp_path):
         with pytest.raises(InputError, match=message) as caught:
             read_log(tmp_path / "log")
         assert caught.value.value == value
+
+
+# -- input the review found mishandled ------------------------------------------------------
+def test_ids_written_with_a_zero_fraction_are_the_same_agents_in_every_file(tmp_path):
+    # a float column written out ("12.0") and an integer one ("12") name the same agents
+    log = read_log(folder(tmp_path, "t,a,b\n0,12.0,3.0\n1,3.0,4.0\n", status="t,agent,state\n0,12,WF\n"))
+    assert log.agent_ids.tolist() == [3, 4, 12] and log.n_agents == 3
+    assert log.ids_of(log.status_agent).tolist() == [12]
+
+
+def test_a_status_file_none_of_whose_agents_met_anyone_is_refused(tmp_path):
+    # "a1" in events, "A1" in status: without a declared agent set, nothing ties them together
+    err = read_error(folder(tmp_path, "t,a,b\n0,a1,a2\n1,a2,a3\n", status="t,agent,state\n0,A1,WF\n0,A2,RW\n"))
+    assert (err.file, err.column, err.value) == (str(tmp_path / "status.csv"), "agent", "A1")
+    assert "none of its agents appears in events.csv" in err.reason
+    # one status agent among the events is enough (the others met nobody, which is fine) ...
+    (tmp_path / "status.csv").write_text("t,agent,state\n0,A1,WF\n0,a2,RW\n")
+    assert read_log(tmp_path).n_agents == 4
+    # ... and so is a declared agent set that holds them all
+    (tmp_path / "status.csv").write_text("t,agent,state\n0,A1,WF\n")
+    (tmp_path / "meta.json").write_text('{"agent_ids": ["a1", "a2", "a3", "A1"]}')
+    assert read_log(tmp_path).n_agents == 4
+
+
+@pytest.mark.parametrize("data, fragment", [
+    (gzip.compress(b"t,a,b\n0,1,2\n"), "gzip-compressed: gunzip it first"),
+    (b"PAR1\x15\x04\x15\x00\x00t,a,b\n", "binary data, not text: line 1 holds a NUL byte"),
+    (b"t,a,b\n0,1,2\n1,2\x00,3\n", "binary data, not text: line 3 holds a NUL byte"),
+], ids=["gzip", "parquet", "nul"])
+def test_a_binary_or_compressed_events_csv_is_one_line(tmp_path, data, fragment):
+    (tmp_path / "events.csv").write_bytes(data)
+    err = read_error(tmp_path)
+    assert err.file == str(tmp_path / "events.csv") and err.reason.startswith(fragment)
+
+
+def test_a_ragged_row_that_is_not_utf8_is_named_without_a_traceback(tmp_path, monkeypatch):
+    # pyarrow fails to decode such a row for its invalid-row handler (printed as an
+    # "Exception ignored" traceback); the byte is named instead
+    unraisable = []
+    monkeypatch.setattr("sys.unraisablehook", unraisable.append)
+    (tmp_path / "events.csv").write_bytes(b"t,a,b\n0,1,2\n1,Jos\xe9\n")
+    err = read_error(tmp_path)
+    assert err.reason == "not UTF-8 text: line 3 holds the byte 0xe9; save the file as UTF-8"
+    assert unraisable == []
+
+
+def test_a_ragged_row_is_quoted_as_a_value(tmp_path):
+    err = read_error(folder(tmp_path, "t,a,b\n0,1,2\n1,2,3,\x1b[31mred\n"))
+    assert (err.row, err.value) == (2, "1,2,3,\x1b[31mred") and "'1,2,3,\\x1b[31mred'" in str(err)
+
+
+def test_repeated_names_among_ignored_columns_are_fine(tmp_path):
+    # Excel's trailing empty columns: header "t,a,b,,", rows ending ",,"
+    log = read_log(folder(tmp_path, "t,a,b,,\n0,1,2,,\n1,2,3,,\n", status="t,agent,state,x,x\n0,1,RW,,\n"))
+    assert log.n_events == 2 and log.agent_ids.tolist() == [1, 2, 3]
+    for events in ("t,a,b, a\n0,1,2,3\n", "t,a,b,t\n0,1,2,3\n"):
+        err = read_error(folder(tmp_path, events, status="t,agent,state\n0,1,RW\n"))
+        assert err.reason == "column appears twice" and err.column in ("a", "t")
+
+
+def test_narrow_float_times_are_refused_when_they_were_rounded(tmp_path):
+    times = np.array([1.4e9, 1.4e9 + 30.0, 1.4e9 + 60.0])
+    pq.write_table(pa.table({"t": pa.array(times.astype(np.float32)), "a": [1, 2, 3], "b": [2, 3, 4]}),
+                   tmp_path / "events.parquet")
+    err = read_error(tmp_path)
+    assert (err.file, err.column) == (str(tmp_path / "events.parquet"), "t")
+    assert err.reason.startswith("a float time column tells times apart only to 128 s at its largest value")
+    # small float32 / float16 times are exact in float64: read as they are
+    for kind, values in ((np.float32, [0.5, 1.25, 1000.125]), (np.float16, [0.5, 1.25, 1.5])):
+        pq.write_table(pa.table({"t": pa.array(np.array(values, kind)), "a": [1, 2, 3], "b": [2, 3, 4]}),
+                       tmp_path / "events.parquet")
+        assert read_log(tmp_path).t.tolist() == values
+    pq.write_table(pa.table({"t": pa.array(np.array([0.5, 2048.0], np.float16)), "a": [1, 2], "b": [2, 3]}),
+                   tmp_path / "events.parquet")
+    assert read_error(tmp_path).reason.startswith("a halffloat time column tells times apart only to 2 s")
+
+
+def test_an_id_column_of_lists_is_refused_naming_its_type(tmp_path):
+    pq.write_table(pa.table({"t": [0.0, 1.0], "a": pa.array([[1], [2]]), "b": [2, 3]}), tmp_path / "events.parquet")
+    err = read_error(tmp_path)
+    assert (err.file, err.column) == (str(tmp_path / "events.parquet"), "a")
+    assert err.reason.startswith("agent IDs must be integers or text, not list<")

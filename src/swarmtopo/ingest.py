@@ -10,7 +10,8 @@ Formats
 -------
 ``csv`` / ``parquet``
     One encounter per row, columns ``t, a, b`` (names configurable).  IDs are text;
-    if every ID is a plain integer (``7``, not ``007``) they become integers.
+    if every ID is written as an integer (``7`` or ``7.0``, not ``007``) they become
+    integers.  A CSV file may be gzip-compressed; it must be UTF-8 throughout.
 ``sociopatterns``
     Lines ``t i j Ci Cj`` (or ``t i j``), fields separated by any blanks: agents
     ``i`` and ``j`` were in contact during the window ``(t - w, t]`` (w = 20 s in the
@@ -32,9 +33,11 @@ Malformed lines
 ---------------
 A line is malformed if it has the wrong number of fields, a time that is not a
 finite number >= 0 (>= w for SocioPatterns), an empty ID, ``a == b``, a ONE state
-other than up / down, or text that is not UTF-8.  Without ``skip_bad`` the first one
-raises an :class:`~.errors.InputError` naming the file, the line (text formats; for
-CSV and Parquet the 1-based data row, header not counted), the field and the value.
+other than up / down, or text that is not UTF-8 (a CSV file that is not UTF-8 is
+refused whole: pyarrow cannot hand such a row back to be skipped).  Without
+``skip_bad`` the first one raises an :class:`~.errors.InputError` naming the file, the
+line (text formats; for CSV and Parquet the 1-based data row, header not counted), the
+field and the value.
 With ``skip_bad`` malformed lines are dropped and counted in the report.  Blank
 lines are not malformed: they are counted and ignored.
 """
@@ -42,6 +45,7 @@ lines are not malformed: they are counted and ignored.
 from __future__ import annotations
 
 import gzip
+import itertools
 import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -53,7 +57,7 @@ import pyarrow.csv as pcsv
 import pyarrow.parquet as pq
 
 from .errors import InputError, SwarmtopoError
-from .io import _PLAIN_INTEGER
+from .io import _GZIP_MAGIC, _SNIFF_BYTES, coarse_time, integer_ids, non_utf8_problem, refuse_binary
 from .log import MAX_TIME, TOO_LATE, EncounterLog
 
 FORMATS: tuple[str, ...] = ("csv", "parquet", "sociopatterns", "one")
@@ -122,6 +126,9 @@ def read_table_trace(path, *, fmt: str = "csv", skip_bad: bool = False, time_col
     """A CSV or Parquet table, one encounter ``(t, a, b)`` per row."""
     path = _existing(path)
     names = {"t": time_column, "a": a_column, "b": b_column}
+    if len(set(names.values())) < 3:
+        raise SwarmtopoError(f"the time and the two ID columns must be three different columns, not "
+                             f"{time_column!r}, {a_column!r}, {b_column!r}")
     rows = _Rows(str(path), skip_bad)
     for line, cols in (_csv_batches(path, names, rows) if fmt == "csv" else _parquet_batches(path, names, rows)):
         blank = _blank_row(cols) if fmt == "csv" else np.zeros(len(line), bool)  # Parquet has no blank lines
@@ -230,7 +237,8 @@ def _connection_starts(t, lo, hi, up) -> tuple[np.ndarray, dict[str, int]]:
     last_of_pair = ~np.r_[same_pair[1:], False]
     opens = ups & ~prev_up
     k = np.flatnonzero(opens)  # the opening lines, in (pair, time) order
-    at_once = np.r_[False, (los[k[1:]] == los[k[:-1]]) & (his[k[1:]] == his[k[:-1]]) & (ts[k[1:]] == ts[k[:-1]])]
+    at_once = np.zeros(len(k), bool)  # none when no line opens (a trace without an up)
+    at_once[1:] = (los[k[1:]] == los[k[:-1]]) & (his[k[1:]] == his[k[:-1]]) & (ts[k[1:]] == ts[k[:-1]])
     opens[k[at_once]] = False
     start = np.empty(len(t), bool)
     start[order] = opens
@@ -281,12 +289,9 @@ def _build(t, a, b, line, rows: "_Rows", fmt: str, meta_extra: dict) -> Encounte
         report = rows.report(fmt)
         raise InputError(f"no encounters in the trace ({report.lines} lines read, {report.skipped} skipped as "
                          f"malformed, {report.counts.get('blank_lines', 0)} blank)", file=rows.file)
-    as_int = all(pc.all(pc.match_substring_regex(c, _PLAIN_INTEGER)).as_py() for c in (a, b))
-    if as_int:
-        try:
-            a, b = (pc.cast(c, pa.int64()).to_numpy(zero_copy_only=False) for c in (a, b))
-        except pa.ArrowInvalid:  # beyond int64: keep text
-            pass
+    as_int = integer_ids([a, b])
+    if as_int is not None:
+        a, b = (c.to_numpy(zero_copy_only=False) for c in as_int)
     meta = {"units": {"time": "s"}, "ingest": {**rows.report(fmt).as_meta(), **meta_extra}}
     return EncounterLog.from_records(t, a, b, meta=meta, source={"events": rows.file}, event_rows=line)
 
@@ -389,6 +394,7 @@ def _csv_batches(path: Path, names: dict[str, str], rows: _Rows):
     Single-threaded parsing, so rows that do not split into the header's columns reach
     the handler in order with their line numbers; blank lines arrive as empty rows.
     """
+    _check_csv_text(path)  # so that pyarrow can hand every row to the handler as text
     header = _csv_header(path)
     names = {key: _column_of(header, col, path) for key, col in names.items()}
     bad_rows: list[int] = []  # data rows the parser could not split, all so far
@@ -400,9 +406,9 @@ def _csv_batches(path: Path, names: dict[str, str], rows: _Rows):
         return "skip"
 
     convert = pcsv.ConvertOptions(include_columns=list(dict.fromkeys(names.values())),
-                                  column_types={c: pa.binary() for c in names.values()}, strings_can_be_null=False)
+                                  column_types={c: pa.string() for c in names.values()}, strings_can_be_null=False)
     try:
-        reader = pcsv.open_csv(path, read_options=pcsv.ReadOptions(use_threads=False, block_size=_BLOCK),
+        reader = pcsv.open_csv(_csv_bytes(path), read_options=pcsv.ReadOptions(use_threads=False, block_size=_BLOCK),
                                parse_options=pcsv.ParseOptions(invalid_row_handler=invalid, ignore_empty_lines=False),
                                convert_options=convert)
         delivered = 0
@@ -413,19 +419,37 @@ def _csv_batches(path: Path, names: dict[str, str], rows: _Rows):
             line = k + np.searchsorted(skipped, k, side="right")
             delivered += batch.num_rows
             rows.lines += batch.num_rows
-            cols = {key: batch.column(col) for key, col in names.items()}
-            ok = np.ones(batch.num_rows, bool)
-            for key, col in cols.items():
-                ok &= rows.reject(ok & _not_utf8(col), line, names[key], col, "not UTF-8 text")
-            sel = pa.array(ok)
-            yield line[ok], {key: _trim(pc.cast(col.filter(sel), pa.string())) for key, col in cols.items()}
+            yield line, {key: _trim(batch.column(col)) for key, col in names.items()}
         rows.lines += len(bad_rows)
     except pa.ArrowInvalid as exc:
-        if "UTF8" in str(exc):
-            raise InputError("not UTF-8 text; save the file as UTF-8", file=str(path)) from None
         raise InputError(f"cannot parse CSV ({exc})", file=str(path)) from None
     except OSError as exc:  # a truncated or corrupt .gz
         raise InputError(f"cannot read the file ({exc})", file=str(path)) from None
+
+
+def _csv_bytes(path: Path) -> pa.NativeFile:
+    """The CSV file's bytes: gunzipped if it is gzip, by content as the text formats (other
+    compressions by name, as pyarrow detects them)."""
+    with open(path, "rb") as f:
+        gzipped = f.read(2) == _GZIP_MAGIC
+    return pa.input_stream(str(path), compression="gzip" if gzipped else "detect")
+
+
+def _check_csv_text(path: Path) -> None:
+    """Refuse a CSV file that is binary (a NUL byte in its first block) or not UTF-8 throughout.
+
+    pyarrow decodes a row its parser cannot split before handing it to Python, and fails
+    on one that is not UTF-8: so a CSV trace is checked whole first (one pass in C).
+    """
+    try:
+        with _csv_bytes(path) as f:
+            head = f.read(_SNIFF_BYTES)
+            refuse_binary(path, head)
+            problem = non_utf8_problem(itertools.chain([head], iter(lambda: f.read(_BLOCK), b"")))
+    except (OSError, pa.ArrowInvalid) as exc:  # a truncated or corrupt .gz
+        raise InputError(f"cannot read the file ({exc})", file=str(path)) from None
+    if problem:
+        raise InputError(problem, file=str(path))
 
 
 def _column_of(header: list[str], name: str, path: Path) -> str:
@@ -441,10 +465,10 @@ def _column_of(header: list[str], name: str, path: Path) -> str:
 
 def _csv_header(path: Path) -> list[str]:
     try:
-        with pcsv.open_csv(path, read_options=pcsv.ReadOptions(block_size=1 << 16),
+        with pcsv.open_csv(_csv_bytes(path), read_options=pcsv.ReadOptions(block_size=1 << 16),
                            parse_options=pcsv.ParseOptions(invalid_row_handler=lambda row: "skip")) as reader:
             return reader.schema.names
-    except (pa.ArrowInvalid, UnicodeDecodeError, OSError) as exc:
+    except (pa.ArrowInvalid, OSError) as exc:
         raise InputError(f"cannot read the CSV header ({exc})", file=str(path)) from None
 
 
@@ -463,6 +487,10 @@ def _parquet_batches(path: Path, names: dict[str, str], rows: _Rows):
             arr = batch.column(batch.schema.names.index(col))
             if pa.types.is_dictionary(arr.type):
                 arr = arr.dictionary_decode()
+            coarse = coarse_time(arr) if key == "t" else None
+            if coarse is not None:
+                i, problem = coarse
+                raise InputError(problem, file=str(path), row=start + i + 1, column=col, value=arr[i].as_py())
             if key == "t" and pa.types.is_temporal(arr.type):
                 rows.time_type = f"{arr.type}, read as seconds" + (" since 1970-01-01" if not (
                     pa.types.is_duration(arr.type) or pa.types.is_time(arr.type)) else "")

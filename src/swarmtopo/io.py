@@ -26,10 +26,12 @@ are in seconds, positions in millimetres.  The ``meta.json`` keys ``format``
 (:data:`LOG_FORMAT`, this layout) and ``version`` (of the swarmtopo that made the log)
 are optional; simulated logs carry both, and :func:`read_log` refuses a folder of
 another ``format``.  Agent IDs are integers or text: in a CSV file an ID column is
-integer only if every ID in the folder is written as a plain integer (``7``, not
-``007`` or ``7.0``) and ``meta.json`` does not declare text ``agent_ids``; otherwise all
-IDs are text, so ``"007"`` stays ``"007"``.  Extra columns are ignored by
-:func:`read_log` and kept by :func:`read_truth` / :func:`read_trajectories`.
+integer only if every ID in the folder is written as an integer (``7``, or ``7.0`` as a
+float column is often written: the same agent; not ``007`` or ``-0``) and ``meta.json``
+does not declare text ``agent_ids``; otherwise all IDs are text, so ``"007"`` stays
+``"007"``.  Extra columns are ignored by :func:`read_log` (a name they repeat, such as
+the empty names of trailing empty columns, too) and kept by :func:`read_truth` /
+:func:`read_trajectories`.
 
 CSV and Parquet go through pyarrow (multi-threaded C++ readers) and ID columns are
 dictionary-encoded, never turned into Python objects row by row: 10^6 events read in
@@ -40,6 +42,7 @@ and the value; so is a file system refusing a read or a write.
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import os
@@ -71,7 +74,15 @@ GROUND_TRUTH_FILES = ("arena.geojson", *(f"{stem}.{fmt}" for stem in ("truth", "
 _TABLE_STEMS = ("events", "status", "truth", "trajectories")
 _OTHER_ENCODINGS = ((b"\xff\xfe\x00\x00", "UTF-32"), (b"\x00\x00\xfe\xff", "UTF-32"),
                     (b"\xff\xfe", "UTF-16"), (b"\xfe\xff", "UTF-16"))
-_PLAIN_INTEGER = r"^(0|-?[1-9][0-9]*)$"  # not 017, not -0: those stay text
+_INTEGER_TEXT = r"^(0|-?[1-9][0-9]*)(\.0+)?$"
+"""An ID written as an integer: plain (not 017, not -0: those stay text), or with a zero
+fraction, as a float column is often written (12.0 is agent 12, as in a Parquet float column)."""
+_GZIP_MAGIC = b"\x1f\x8b"
+_SNIFF_BYTES = 1 << 16  # the first block of a CSV file checked for binary data
+MAX_TIME_RESOLUTION = 1e-3
+"""Coarsest spacing (s) a float16 / float32 time column may have at its largest value:
+beyond it the file's times were already rounded when written (float32 epoch seconds are
+128 s apart), so they are refused rather than read as fewer, shifted times."""
 
 
 # -- log folders -------------------------------------------------------------------------
@@ -204,10 +215,26 @@ def read_log(directory) -> EncounterLog:
         t, ids[0], ids[1], status=status_cols, static=static_cols, meta=meta,
         source={"events": str(events_path), "status": str(status_path), "static": f"{meta_path} static"},
     )
+    if meta.get("agent_ids") is None and meta.get("agent_count") is None:
+        _refuse_unmatched_status(log, status_path, events_path)
     if "duration" in meta and meta["duration"] < log.last_time:
         raise InputError(f"key 'duration' is {meta['duration']:g} s but the log runs to t = {log.last_time:g} s",
                          file=str(meta_path), column="duration", value=meta["duration"])
     return log
+
+
+def _refuse_unmatched_status(log: EncounterLog, status_path, events_path) -> None:
+    """Without a declared agent set, a status file none of whose agents is in any event
+    (while there are events) spells its IDs differently from the events: refused."""
+    if not (log.n_events and len(log.status_agent)):
+        return
+    met = np.zeros(log.n_agents, bool)
+    met[log.a] = met[log.b] = True
+    if not met[log.status_agent].any():
+        example = log.ids_of(log.status_agent[:1])[0]
+        raise InputError(f"none of its agents appears in {events_path.name} (are the IDs written the same way in "
+                         f"both files?)", file=str(status_path), column="agent",
+                         value=int(example) if isinstance(example, np.integer) else example)
 
 
 def read_truth(directory) -> dict[str, np.ndarray] | None:
@@ -507,9 +534,9 @@ def _read_table(path: Path, required: tuple[str, ...], *, keep_all: bool = False
             raise InputError(f"cannot read Parquet file ({exc})", file=str(path)) from None
     by_name = {}
     for raw in names:
-        if raw.strip() in by_name:
+        if raw.strip() in by_name and (keep_all or raw.strip() in (*required, "state")):
             raise InputError("column appears twice", file=str(path), column=raw.strip())
-        by_name[raw.strip()] = raw
+        by_name.setdefault(raw.strip(), raw)  # a name repeated among the ignored columns is never read
     missing = [c for c in required if c not in by_name]
     if missing:
         raise InputError(f"missing column '{missing[0]}'; found columns: {', '.join(map(repr, by_name)) or 'none'}",
@@ -537,20 +564,51 @@ def _read_table(path: Path, required: tuple[str, ...], *, keep_all: bool = False
 def _csv_header(path: Path) -> list[str]:
     try:
         with open(path, "rb") as f:
-            start = f.read(4)
-        for bom, encoding in _OTHER_ENCODINGS:
-            if start.startswith(bom):
-                raise InputError(f"not UTF-8 text: it starts with the byte-order mark of {encoding}; "
-                                 f"save it as UTF-8", file=str(path))
+            refuse_binary(path, f.read(_SNIFF_BYTES))
         with pcsv.open_csv(path, read_options=pcsv.ReadOptions(block_size=1 << 16)) as reader:
             return reader.schema.names
     except UnicodeDecodeError as exc:
         raise InputError(f"not UTF-8 text: the header row holds the byte 0x{exc.object[exc.start]:02x} "
                          f"({exc.reason})", file=str(path)) from None
     except pa.ArrowInvalid as exc:
-        raise InputError(_csv_problem(path, exc), file=str(path)) from None
+        raise _csv_problem(path, exc) from None
     except OSError as exc:
         raise InputError(f"cannot read file ({_os_reason(exc)})", file=str(path)) from None
+
+
+def refuse_binary(path: Path, head: bytes) -> None:
+    """InputError naming ``path`` if ``head``, the first block of a text file, starts with
+    the byte-order mark of UTF-16 / UTF-32, is gzip, or holds a NUL byte (binary data: a
+    spreadsheet, an archive, UTF-16 without a byte-order mark)."""
+    for bom, encoding in _OTHER_ENCODINGS:
+        if head.startswith(bom):
+            raise InputError(f"not UTF-8 text: it starts with the byte-order mark of {encoding}; save it as UTF-8",
+                             file=str(path))
+    if head.startswith(_GZIP_MAGIC):
+        raise InputError("gzip-compressed: gunzip it first", file=str(path))
+    nul = head.find(b"\0")
+    if nul >= 0:
+        line = head.count(b"\n", 0, nul) + 1
+        raise InputError(f"binary data, not text: line {line} holds a NUL byte (save the table as UTF-8 CSV)",
+                         file=str(path))
+
+
+def non_utf8_problem(blocks) -> str | None:
+    """Where the bytes ``blocks`` (an iterable of consecutive blocks) stop being UTF-8
+    text, as a message naming the line and the byte; None if they are UTF-8 throughout."""
+    line, tail = 1, b""
+    for block in itertools.chain(blocks, [b""]):  # b"": the end, where a cut character is an error
+        data = tail + block
+        try:
+            data.decode("utf-8")
+            tail = b""
+        except UnicodeDecodeError as exc:
+            if not (block and exc.reason == "unexpected end of data"):
+                line += data.count(b"\n", 0, exc.start)
+                return f"not UTF-8 text: line {line} holds the byte 0x{data[exc.start]:02x}; save the file as UTF-8"
+            data, tail = data[:exc.start], data[exc.start:]  # a character cut by the block's end
+        line += data.count(b"\n")
+    return None
 
 
 def _read_csv(path: Path, columns: list[str], text: set[str]) -> pa.Table:
@@ -561,15 +619,18 @@ def _read_csv(path: Path, columns: list[str], text: set[str]) -> pa.Table:
     except pa.ArrowInvalid as exc:
         if "invalid UTF8" in str(exc):
             raise _not_utf8(path, columns, text) from None
-        raise InputError(_csv_problem(path, exc), file=str(path)) from None
+        raise _csv_problem(path, exc) from None
     except OSError as exc:
         raise InputError(f"cannot read file ({_os_reason(exc)})", file=str(path)) from None
 
 
 def _not_utf8(path: Path, columns: list[str], text: set[str]) -> InputError:
     """The error for a text column that is not UTF-8, at its first bad row."""
-    raw = pcsv.read_csv(path, convert_options=pcsv.ConvertOptions(
-        include_columns=columns, column_types={c: pa.binary() for c in text}))
+    try:
+        raw = pcsv.read_csv(path, convert_options=pcsv.ConvertOptions(
+            include_columns=columns, column_types={c: pa.binary() for c in text}))
+    except pa.ArrowInvalid as exc:  # a row that does not parse either
+        return _csv_problem(path, exc)
     bad = []
     for name in columns:
         if name in text:
@@ -585,8 +646,17 @@ def _not_utf8(path: Path, columns: list[str], text: set[str]) -> InputError:
     return InputError("not UTF-8 text", file=str(path), row=i + 1, column=name.strip(), value=value)
 
 
-def _csv_problem(path: Path, exc: Exception) -> str:
-    """pyarrow's parse error, with the 1-based data row found by a single-threaded re-read."""
+def _csv_problem(path: Path, exc: Exception) -> InputError:
+    """pyarrow's parse error, with the 1-based data row and its text found by a
+    single-threaded re-read; or, in a file that is not UTF-8 throughout (pyarrow cannot
+    hand such a row to Python), the first byte that is not."""
+    try:
+        with open(path, "rb") as f:
+            not_utf8 = non_utf8_problem(iter(lambda: f.read(1 << 22), b""))
+    except OSError as err:
+        return InputError(f"cannot read file ({_os_reason(err)})", file=str(path))
+    if not_utf8:
+        return InputError(not_utf8, file=str(path))
     bad = []
 
     def record(row):
@@ -598,12 +668,13 @@ def _csv_problem(path: Path, exc: Exception) -> str:
                       parse_options=pcsv.ParseOptions(invalid_row_handler=record))
     except pa.ArrowInvalid:
         pass
-    # pyarrow >= 26.0.1 prefixes its own "Row #N: " (a file line, header included):
-    # dropped, so the message names one row, counted like every other message here
-    reason = re.sub(r"^Row #\d+: ", "", str(exc).removeprefix("CSV parse error: "))
     if bad and bad[0].number is not None:  # number counts the header as row 1
-        return f"row {bad[0].number - 1}: cannot parse CSV ({reason})"
-    return f"cannot parse CSV ({reason})"
+        return InputError(f"cannot parse CSV (expected {bad[0].expected_columns} columns, found "
+                          f"{bad[0].actual_columns})", file=str(path), row=bad[0].number - 1, value=bad[0].text)
+    # pyarrow >= 26.0.1 prefixes its own "Row #N: " (a file line, header included): dropped, as
+    # every message here counts data rows
+    reason = re.sub(r"^Row #\d+: ", "", str(exc).removeprefix("CSV parse error: "))
+    return InputError(f"cannot parse CSV ({reason})", file=str(path))
 
 
 def _number_column(col: pa.Array, path: Path, name: str, what: str) -> np.ndarray:
@@ -618,6 +689,10 @@ def _number_column(col: pa.Array, path: Path, name: str, what: str) -> np.ndarra
             problem = f"{what} is missing" if value == "" else f"{what} is not a number"
             raise InputError(problem, file=str(path), row=i + 1, column=name, value=value) from None
     elif pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_decimal(kind):
+        coarse = coarse_time(col) if what == "time" else None
+        if coarse is not None:
+            i, problem = coarse
+            raise InputError(problem, file=str(path), row=i + 1, column=name, value=col[i].as_py())
         col = pc.cast(col, pa.float64(), safe=False)  # integers beyond 2^53 round; times that large are refused
     elif pa.types.is_null(kind) and len(col) == 0:
         col = pa.array([], pa.float64())
@@ -628,6 +703,24 @@ def _number_column(col: pa.Array, path: Path, name: str, what: str) -> np.ndarra
         i = int(np.argmax(col.is_null().to_numpy(zero_copy_only=False)))
         raise InputError(f"{what} is missing", file=str(path), row=i + 1, column=name)
     return col.to_numpy(zero_copy_only=False)
+
+
+def coarse_time(col: pa.Array) -> tuple[int, str] | None:
+    """(index of the largest time, message) if ``col`` is a float16 / float32 column whose
+    spacing at its largest finite value exceeds ``MAX_TIME_RESOLUTION``; else None (the
+    column is read as float64, exactly)."""
+    if not (pa.types.is_float16(col.type) or pa.types.is_float32(col.type)):
+        return None
+    values = col.fill_null(0).to_numpy(zero_copy_only=False)
+    finite = np.isfinite(values)
+    if not finite.any():
+        return None
+    i = int(np.argmax(np.where(finite, np.abs(values), -1)))
+    spacing = float(np.spacing(np.abs(values[i])))
+    if spacing <= MAX_TIME_RESOLUTION:
+        return None
+    return i, (f"a {col.type} time column tells times apart only to {spacing:g} s at its largest value (the "
+               f"file's times were rounded when written); write them as float64 or integers")
 
 
 def _first_uncastable(col: pa.Array, to_type) -> int:
@@ -648,33 +741,51 @@ def _id_arrays(columns: list[tuple[pa.Array, Path, str]], *, declared_text: bool
     """Give all ID columns of a folder one kind: int64 numpy arrays, or pyarrow text.
 
     Integer if every column is integer-typed (floats are left to the log's integrality
-    check) or, in CSV, holds only plain integers, and meta declares no text IDs.  Text
-    columns of a Parquet file are text whatever they hold.
+    check) or, in CSV, holds only IDs written as integers (:func:`integer_ids`), and meta
+    declares no text IDs.  Text columns of a Parquet file are text whatever they hold;
+    a column that cannot be read as text (a list, a struct) is refused.
     """
+    checked = []  # (column, is numeric, from a CSV file)
     for col, path, name in columns:
         if col.null_count:
             i = int(np.argmax(col.is_null().to_numpy(zero_copy_only=False)))
             raise InputError("agent ID is missing", file=str(path), row=i + 1, column=name)
-
-    def integer_like(col: pa.Array, path: Path) -> bool:
-        if pa.types.is_integer(col.type) or pa.types.is_floating(col.type):
-            return True
-        if path.suffix == ".csv":  # CSV has no types: every ID column was read as text
-            return pc.all(pc.match_substring_regex(col, _PLAIN_INTEGER)).as_py() is not False
-        return False
-
-    as_int = not declared_text and all(integer_like(col, path) for col, path, _ in columns)
-    out = []
-    for col, _, _ in columns:
-        if as_int and not pa.types.is_floating(col.type):
+        numeric = pa.types.is_integer(col.type) or pa.types.is_floating(col.type)
+        if not numeric:
             try:
-                col = pc.cast(col, pa.int64())
-            except pa.ArrowInvalid:  # a plain integer beyond int64: treat every ID as text
-                return _id_arrays(columns, declared_text=True)
-        elif not as_int:
-            col = pc.cast(col, pa.string())
-        out.append(col.to_numpy(zero_copy_only=False) if as_int else col)
-    return out
+                col = pc.cast(col, pa.string())
+            except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
+                raise InputError(f"agent IDs must be integers or text, not {col.type}", file=str(path),
+                                 column=name) from None
+        checked.append((col, numeric, path.suffix == ".csv"))
+    if not declared_text and all(numeric or csv for _, numeric, csv in checked):  # CSV has no types
+        texts = integer_ids([col for col, numeric, _ in checked if not numeric])
+        if texts is not None:
+            texts = iter(texts)
+            try:
+                ints = [col if pa.types.is_floating(col.type) else pc.cast(col, pa.int64()) if numeric else next(texts)
+                        for col, numeric, _ in checked]
+            except pa.ArrowInvalid:  # an unsigned integer beyond int64: every ID is text
+                pass
+            else:
+                return [col.to_numpy(zero_copy_only=False) for col in ints]
+    return [pc.cast(col, pa.string()) if numeric else col for col, numeric, _ in checked]
+
+
+def integer_ids(columns: list[pa.Array]) -> list[pa.Array] | None:
+    """Text ID columns as int64, if every ID is written as an integer (``12``, or ``12.0``
+    for the same agent; not ``012`` or ``-0``) and fits int64; else None.  Exact: the
+    integer part is parsed as text, never through a float.  The text work is done once per
+    distinct ID."""
+    encoded = [pc.dictionary_encode(col) for col in columns]
+    if not all(pc.all(pc.match_substring_regex(enc.dictionary, _INTEGER_TEXT)).as_py() is not False
+               for enc in encoded):
+        return None
+    try:
+        return [pc.take(pc.cast(pc.replace_substring_regex(enc.dictionary, r"\.0+$", ""), pa.int64()), enc.indices)
+                for enc in encoded]
+    except pa.ArrowInvalid:  # beyond int64: every ID is text
+        return None
 
 
 def _id_numpy(ids) -> np.ndarray:
