@@ -8,7 +8,7 @@ import pytest
 
 from swarmtopo.arena import default_arena, square_arena, two_rooms_arena
 from swarmtopo.classify import load_classifier
-from swarmtopo.errors import SwarmtopoError
+from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.log import EncounterLog
 from swarmtopo.pipeline import (DIFFUSION_GAP_FACTOR, HOP_GAP_FACTOR, WHOLE_LOG, MapConfig, _share_landmarks,
                                 _scaled_windows, _windows, map_encounters, mean_agent_gap, resolve_diffusion_time, resolve_hop_cost,
@@ -519,3 +519,41 @@ def test_a_hole_count_beyond_the_calibrated_arenas_is_flagged():
     assert _extrapolation_warnings({0: 1, 1: None}) == []
     (line,) = _extrapolation_warnings({0: 1, 1: CALIBRATED_HOLES + 5})
     assert line.startswith(f"beta_1 = {CALIBRATED_HOLES + 5} is beyond the 0-{CALIBRATED_HOLES} holes")
+
+
+def test_a_silence_that_stretches_the_window_to_the_whole_log_is_still_a_warning():
+    # 10 s of meetings, then the same 10 s shifted by 10^6 s: the silence inflates the mean
+    # gap so much that the automatic window is the whole log, and it was not compared
+    rng = np.random.default_rng(6)
+    t = np.sort(rng.uniform(0.0, 10.0, 200))
+    a = rng.integers(0, 60, len(t))
+    b = (a + rng.integers(1, 60, len(t))) % 60
+    log = EncounterLog.from_records(np.r_[t, t + 1e6], np.r_[a, a], np.r_[b, b])
+    tmap = map_encounters(log, MapConfig(**FAST))
+    assert tmap.window_length[0] == WHOLE_LOG
+    gap, rest = 1e6 + t[0] - t[-1], 2 * (t[-1] - t[0])
+    assert tmap.warnings[0].startswith(f"the log is silent for {gap:.6g} s (t = ")
+    assert f"longer than the rest of the log ({rest:.3g} s)" in tmap.warnings[0]
+    # the same meetings without the silence, mapped whole: no warning
+    quiet = map_encounters(EncounterLog.from_records(t, a, b), MapConfig(window_length=WHOLE_LOG, **FAST))
+    assert not any("silent" in w for w in quiet.warnings)
+
+
+@pytest.mark.parametrize("r_d, v_c", [(1e200, 15.0), (30.0, 1e-300), (1e308, 1e-300)])
+def test_a_per_hop_cost_from_meta_beyond_the_bound_is_refused(r_d, v_c):
+    log = EncounterLog.from_records([0.0, 1.0, 3.0, 4.0], [1, 1, 2, 1], [2, 3, 3, 2], meta={"r_d": r_d, "v_c": v_c})
+    with pytest.raises(InputError, match=r"^meta.json: r_d = .* per-hop cost r_d / v_c of .*, more than 1e\+09 s"):
+        resolve_hop_cost(log, None)
+    assert resolve_hop_cost(log, 2.0) == (2.0, "given")  # not read when the cost is given
+
+
+def test_a_swarm_static_from_the_start_says_there_is_nothing_to_map():
+    rng = np.random.default_rng(7)
+    t = np.sort(rng.uniform(0.0, 20.0, 300))
+    a = rng.integers(0, 40, len(t))
+    b = (a + rng.integers(1, 40, len(t))) % 40
+    static = (np.arange(40), np.zeros(40))
+    log = EncounterLog.from_records(t, a, b, static=static)
+    with pytest.raises(SwarmtopoError, match=r"^the largest connected group of encounters \(300 events among 40 "
+                                             r"agents\) is a single point of the encounter metric"):
+        map_encounters(log, MapConfig(hop_cost=0.0, diffusion_time=WHOLE_LOG, window_length=WHOLE_LOG, **FAST))

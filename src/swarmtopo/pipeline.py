@@ -31,7 +31,7 @@ from .beta0 import BETA0_DEFINITION, Beta0Evidence, beta0_evidence, shipped_beta
 from .classify import BettiClassifier, RegionScales, load_classifier
 from .cycles import Cycle, region_cycles
 from .embed import Embedding, mds
-from .errors import SwarmtopoError
+from .errors import InputError, SwarmtopoError
 from .graph import METRICS, EncounterGraph, agent_gaps, build_graph
 from .io import jsonable
 from .landmarks import SUBSAMPLERS, Landmarks, knn_distances, knn_maxmin, maxmin, probabilistic_maxmin
@@ -495,6 +495,12 @@ def split_regions(log: EncounterLog, config: MapConfig) -> RegionSplit:
     regions = [int(c) for c in np.argsort(-events_per_comp, kind="stable") if is_region[c]]
     if not regions:
         largest = int(np.argmax(events_per_comp))
+        if np.count_nonzero(labels == largest) == 1 and agents_per_comp[largest] >= MIN_REGION_AGENTS:
+            raise SwarmtopoError(
+                f"the largest connected group of encounters ({int(events_per_comp[largest])} events among "
+                f"{int(agents_per_comp[largest])} agents) is a single point of the encounter metric: its agents never "
+                f"moved between their encounters (static from the start, as meta.json 'static' says, or stopped), so "
+                f"there is nothing to map")
         raise SwarmtopoError(
             f"no connected group of encounters has {config.min_region_events} events or more among "
             f"{MIN_REGION_AGENTS} agents or more (largest: {int(events_per_comp[largest])} events among "
@@ -732,7 +738,11 @@ def resolve_hop_cost(log: EncounterLog, hop_cost: float | None) -> tuple[float, 
         return float(hop_cost), "given"
     r_d, v_c = log.meta.get("r_d"), log.meta.get("v_c")
     if all(isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) and x > 0 for x in (r_d, v_c)):
-        return float(r_d) / float(v_c), "r_d / v_c from meta.json"
+        h = float(r_d) / float(v_c)
+        if not h <= MAX_HOP_COST:  # inf too; no file named: the caller knows the log's folder
+            raise InputError(f"meta.json: r_d = {r_d:g} and v_c = {v_c:g} give a per-hop cost r_d / v_c of {h:.3g} s, "
+                             f"more than {MAX_HOP_COST:g} s (the bound of --hop-cost): r_d must be in mm, v_c in mm/s")
+        return h, "r_d / v_c from meta.json"
     gap = mean_agent_gap(log)
     if gap is None:
         return 0.0, "no agent met twice at different times: 0"
@@ -846,13 +856,20 @@ def _evenly(n: int, k: int) -> np.ndarray:
 def _silence_warnings(times: np.ndarray, window_length: float) -> list[str]:
     """A silence between the sorted event ``times`` longer than a window (a night in a
     multi-day trace): it stretches the mean gap the automatic h, windows and diffusion
-    time come from."""
+    time come from.  When the window is the whole log (which such a silence may have
+    stretched it to), one longer than the rest of the log together."""
     gaps = np.diff(times)
-    if not len(gaps) or not np.isfinite(window_length) or gaps.max() <= window_length:
+    if not len(gaps):
         return []
     k = int(np.argmax(gaps))
+    if np.isfinite(window_length):
+        limit, what = window_length, "a window"
+    else:
+        limit, what = float(times[-1] - times[0] - gaps[k]), "the rest of the log"
+    if gaps[k] <= limit:
+        return []
     return [f"the log is silent for {gaps[k]:.6g} s (t = {exact_time(times[k])} to {exact_time(times[k + 1])}), "
-            f"longer than a window ({window_length:.3g} s): silences such as nights inflate the automatic per-hop "
+            f"longer than {what} ({limit:.3g} s): silences such as nights inflate the automatic per-hop "
             f"cost and windows; map each active period with --window T0:T1"]
 
 
