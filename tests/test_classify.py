@@ -218,6 +218,18 @@ def test_malformed_classifier_files_name_the_file(tmp_path):
         load_classifier(tmp_path / "missing.json")
 
 
+@pytest.mark.parametrize("key, model", [("1", {}), ("1", {"intercept": 0.1, "margin": 0.5}),
+                                        ("1", {"intercept": 0.1, "margin": 0.5, "gap": "x"}), ("maps", -3)])
+def test_an_incomplete_calibration_is_refused_naming_the_file_and_key(tmp_path, key, model):
+    good = load_classifier("paper-form").to_json()
+    good["calibration"][key] = model
+    path = tmp_path / "c.json"
+    path.write_text(json.dumps(good))
+    with pytest.raises(InputError, match="a calibration maps 'maps' to a count") as caught:
+        load_classifier(path)
+    assert (caught.value.file, caught.value.column) == (str(path), f"calibration.{key}")
+
+
 def test_shipped_presets():
     paper = load_classifier("paper")
     assert paper.theta_[1] == Theta(*PAPER_THETA[1])

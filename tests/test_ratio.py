@@ -316,3 +316,31 @@ def test_region_reader_reads_a_stored_agreement_list_with_nulls_as_nan():
     assert region_reader(model, REGION, [0.9, 0.5, None, 0.1, 0.1]).vetoed_ == {1: (1,)}
     ungated = RatioClassifier({1: TH})
     assert region_reader(ungated, REGION, None) is ungated  # a score-only classifier never needs A_k
+
+
+@pytest.mark.parametrize("model", [{}, {"z": 2.0}, {"intercept": 0.1, "margin": 1.0}, [0.1, 2.0], 0.5],
+                         ids=["empty", "no-intercept", "half-old", "list", "number"])
+def test_an_incomplete_calibration_is_refused_naming_the_file_and_key(tmp_path, model):
+    import json
+
+    obj = json.loads(json.dumps(load_classifier("default").to_json()))
+    obj["calibration"]["1"] = model
+    path = tmp_path / "c.json"
+    path.write_text(json.dumps(obj))
+    with pytest.raises(InputError, match="a calibration needs 'intercept' and 'z'") as caught:
+        load_classifier(path)
+    assert (caught.value.file, caught.value.column) == (str(path), "calibration.1")
+
+
+def test_an_unknown_classifier_format_lists_the_formats_read(tmp_path):
+    import json
+
+    obj = json.loads(json.dumps(load_classifier("default").to_json()))
+    obj["format"] = "swarmtopo-ratio-classifier/9"
+    path = tmp_path / "c.json"
+    path.write_text(json.dumps(obj))
+    with pytest.raises(InputError) as caught:
+        load_classifier(path)
+    assert (caught.value.file, caught.value.column, caught.value.value) == (str(path), "format", obj["format"])
+    for fmt in ("swarmtopo-classifier/1", "swarmtopo-ratio-classifier/3", "swarmtopo-ratio-classifier/4"):
+        assert f'"{fmt}"' in caught.value.reason

@@ -60,7 +60,8 @@ def check_format(obj, expected: str | tuple[str, ...], what: str, source: str) -
     the newest last); else an InputError naming ``source`` and the format found."""
     accepted = (expected,) if isinstance(expected, str) else tuple(expected)
     if not isinstance(obj, dict) or obj.get("format") not in accepted:
-        raise InputError(f"not a {what} (expected \"format\": \"{accepted[-1]}\")", file=source, column="format",
+        formats = ("" if len(accepted) == 1 else "one of ") + ", ".join(f'"{f}"' for f in accepted)
+        raise InputError(f"not a {what} (expected \"format\": {formats})", file=source, column="format",
                          value=obj.get("format") if isinstance(obj, dict) else obj)
     return obj
 

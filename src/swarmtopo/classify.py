@@ -58,6 +58,8 @@ from .errors import InputError, SwarmtopoError
 from .persistence import Diagram
 
 CLASSIFIER_FORMAT = "swarmtopo-classifier/1"
+CALIBRATION_KEYS = ("intercept", "margin", "gap")
+"""The coefficients of a dimension's confidence model (:meth:`BettiClassifier.confidence`)."""
 MAX_MARGIN = 5.0
 """Cap of the log-ratio margin (a bar e^5 ~ 150 times off the threshold is as sure as it gets)."""
 PAPER_THETA = {1: (0.5, 0.7, 3.7)}
@@ -327,8 +329,7 @@ class BettiClassifier(BaseEstimator):
                 raise InputError(f"Theta_{n} out of range (need 0 <= q <= 1, Delta >= 0, tau > 0)",
                                  file=source, column=f"theta.{n}", value=th.to_json())
         if obj.get("calibration"):
-            # "0": earlier files' beta_0 rate; beta_0's confidence is now the pipeline's (swarmtopo.beta0)
-            model.calibration_ = {n: c for n, c in obj["calibration"].items() if n != "0"}
+            model.calibration_ = _checked_calibration(obj["calibration"], source)
         return model
 
     def save(self, path) -> None:
@@ -405,6 +406,28 @@ def detection_scores(estimated, truth) -> DetectionScores:
 
 
 # -- shipped classifiers ---------------------------------------------------------------
+def _checked_calibration(calibration, source: str) -> dict:
+    """A file's calibration without the earlier files' "0" (beta_0's confidence is now the
+    pipeline's, swarmtopo.beta0); each dimension's model must hold the numbers it is
+    applied with, and "maps" must be a count."""
+    if not isinstance(calibration, dict):
+        raise InputError("must be an object of {dimension: model}", file=source, column="calibration",
+                         value=calibration)
+    out = {n: c for n, c in calibration.items() if n != "0"}
+    for n, model in out.items():
+        if n == "maps":
+            ok = isinstance(model, int) and not isinstance(model, bool) and model >= 0
+        else:
+            ok = isinstance(model, dict) and all(
+                isinstance(model.get(key), (int, float)) and not isinstance(model.get(key), bool)
+                and np.isfinite(model[key]) for key in CALIBRATION_KEYS)
+        if not ok:
+            raise InputError("a calibration maps 'maps' to a count and each dimension to finite numbers "
+                             f"{', '.join(map(repr, CALIBRATION_KEYS))}", file=source, column=f"calibration.{n}",
+                             value=model)
+    return out
+
+
 def load_classifier(name: str | Path):
     """A shipped classifier by name or a JSON file.
 
@@ -430,7 +453,8 @@ def load_classifier(name: str | Path):
             raise InputError(f"no such classifier: expected one of {', '.join(PRESETS)} or a JSON file",
                              file=str(path), value=str(name))
         source, obj = str(path), read_json(path)
-    if isinstance(obj, dict) and obj.get("format") in READ_FORMATS:
+    check_format(obj, (CLASSIFIER_FORMAT, *READ_FORMATS), "swarmtopo classifier", source)
+    if obj["format"] in READ_FORMATS:
         return RatioClassifier.from_json(obj, source=source)
     return BettiClassifier.from_json(obj, source=source)
 

@@ -88,9 +88,11 @@ SCORE_VAR_PRIOR = 0.25 ** 2
 """Prior variance of a window's score at one rank (log units squared): se_k never falls below 0.25 / sqrt(W)."""
 CONFIDENCE_FEATURES = ("z",)
 """The features :meth:`RatioClassifier.calibrate` fits."""
-REGION_FEATURES = ("z", "agreement", "margin", "windows")
-"""Every feature :meth:`RatioClassifier.region_features` gives: a calibration may weigh any of
-them (files calibrated before z weigh the last three)."""
+OLD_FEATURES = ("agreement", "margin", "windows")
+"""The features of files calibrated before z existed."""
+REGION_FEATURES = ("z", *OLD_FEATURES)
+"""Every feature :meth:`RatioClassifier.region_features` gives: a calibration weighs z or,
+in files calibrated before z, the other three."""
 LOG_RATIO_CAP = float(np.log(1e3))
 """Cap of a bar's score: a bar 1000 times the typical noise loop (or infinite) is as long as it gets."""
 
@@ -287,10 +289,14 @@ class RatioClassifier:
                 raise InputError("an agreement gate needs dimension 1, mean pooling and 0 <= agreement < 1",
                                  column=f"thresholds.{n}.agreement", value=th.agreement)
         for n, model in (calibration or {}).items():
-            unknown = set(model) - {"intercept", "maps", *REGION_FEATURES}
+            unknown = set(model) - {"intercept", "maps", *REGION_FEATURES} if isinstance(model, dict) else set()
             if unknown:
                 raise InputError(f"unknown confidence feature(s) {sorted(unknown)}; known: "
                                  f"{', '.join(REGION_FEATURES)}", column=f"calibration.{n}", value=model)
+            if not isinstance(model, dict) or "intercept" not in model or not (
+                    "z" in model or set(OLD_FEATURES) <= set(model)):
+                raise InputError(f"a calibration needs 'intercept' and 'z' (older files: 'intercept', "
+                                 f"{', '.join(map(repr, OLD_FEATURES))})", column=f"calibration.{n}", value=model)
             for key, value in model.items():
                 if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or (
                         key == "maps" and value < 0):
@@ -486,6 +492,9 @@ class RatioClassifier:
                 gate = t.get("agreement") if obj["format"] == RATIO_FORMAT else None  # checked by __init__
                 thresholds[int(n)] = RatioThresholds(float(t["q"]), float(t["tau"]), gate)
             pooling = obj.get("pooling", "mean") if obj["format"] in READ_FORMATS[2:] else "median"
+            if not isinstance(obj.get("calibration") or {}, dict):
+                raise InputError("must be an object of {dimension: model}", column="calibration",
+                                 value=obj["calibration"])
             # "0": earlier files' beta_0 rate; beta_0's confidence is now the pipeline's (swarmtopo.beta0)
             calibration = {n: c for n, c in (obj.get("calibration") or {}).items() if n != "0"}
             return cls(thresholds, calibration or None, obj.get("provenance") or {}, pooling)
