@@ -179,6 +179,27 @@ def test_bad_option_values(simulated, tmp_path):
     assert not (tmp_path / "z").exists()
 
 
+def test_option_values_that_do_not_fit_name_the_option(tmp_path):
+    trace = tmp_path / "trace.csv"
+    trace.write_text("id1,id2,t\n1,2,0\n1,3,1\n")
+    out = tmp_path / "out"
+    assert_one_line_error(run("plan", "--area", 250000, "--agents", 200, "--target", 1), "--target",
+                          "1 is not strictly between 0 and 1", code=2)
+    assert_one_line_error(run("simulate", "--out", out, "--dt", 10), "--dt", "time step too coarse", code=2)
+    assert_one_line_error(run("ingest", trace, "--format", "sociopatterns", "--contact-window", 0, "--out", out),
+                          "--contact-window", "0 is not a finite number > 0", code=2)
+    assert_one_line_error(run("ingest", trace, "--format", "csv", "--contact-window", 10, "--out", out),
+                          "--contact-window", "applies to --format sociopatterns only", code=2)
+    assert_one_line_error(run("ingest", trace, "--format", "one", "--a-column", "id1", "--out", out),
+                          "--a-column", "applies to --format csv or parquet only", code=2)
+    assert_one_line_error(run("ingest", trace, "--format", "csv", "--time-column", "id1", "--a-column", "id1",
+                              "--b-column", "id2", "--out", out), "three different columns", code=2)
+    assert not out.exists()
+    proc = run("ingest", trace, "--format", "csv", "--time-column", "t", "--a-column", "id1", "--b-column", "id2",
+               "--out", out)
+    assert proc.returncode == 0 and read_log(out).n_events == 2
+
+
 def test_simulate_replaces_a_log_only_with_overwrite(tmp_path):
     folder = tmp_path / "deployment"
     folder.mkdir()

@@ -80,6 +80,13 @@ def _finite_option(value: float | None) -> float | None:
     return value
 
 
+def _accuracy_option(value: float | None) -> float | None:
+    """A probability strictly between 0 and 1 (None passes)."""
+    if value is not None and not 0 < value < 1:
+        raise typer.BadParameter(f"{value:g} is not strictly between 0 and 1")
+    return value
+
+
 def _fmt_option(value: str) -> str:
     if value not in ("csv", "parquet"):
         raise typer.BadParameter(f"{value!r} is not one of 'csv', 'parquet'")
@@ -125,11 +132,16 @@ def simulate(
 
     from .arena import random_arena
     from .io import read_arena
-    from .sim import SensingParams, simulate as run
+    from .errors import InputError
+    from .sim import MotionParams, SensingParams, check_time_step, simulate as run
 
     _check_verbosity(quiet, verbose)
     if static_time > 0 and static_fraction == 0:
         raise typer.BadParameter("the static agents' stop time needs --static-fraction > 0", param_hint="--static-time")
+    try:
+        check_time_step(dt, MotionParams(), SensingParams(r_d=rd))  # the motion simulate runs with
+    except InputError as exc:
+        raise typer.BadParameter(exc.reason, param_hint="--dt") from None
 
     # The arena draws from its own stream, spawned from the seed; the swarm uses the seed.
     world = read_arena(arena) if arena else random_arena(holes, scale=scale, rng=np.random.SeedSequence(seed).spawn(1)[0])
@@ -165,25 +177,38 @@ def ingest(
     out_dir: Path = typer.Option(..., "--out", help="Log folder to write (created); swarmtopo map reads it."),
     skip_bad: bool = typer.Option(False, "--skip-bad",
                                   help="Skip malformed lines and count them (default: stop at the first)."),
-    time_column: str = typer.Option("t", "--time-column", help="csv/parquet: column of encounter times (s)."),
-    a_column: str = typer.Option("a", "--a-column", help="csv/parquet: column of the first agent ID."),
-    b_column: str = typer.Option("b", "--b-column", help="csv/parquet: column of the second agent ID."),
-    window: float = typer.Option(20.0, "--contact-window",
-                                 help="sociopatterns: seconds of one contact window (a line at t covers (t-w, t])."),
+    time_column: Optional[str] = typer.Option(None, "--time-column",
+                                              help="csv/parquet: column of encounter times (s) (default t)."),
+    a_column: Optional[str] = typer.Option(None, "--a-column", help="csv/parquet: column of the first agent ID "
+                                                                   "(default a)."),
+    b_column: Optional[str] = typer.Option(None, "--b-column", help="csv/parquet: column of the second agent ID "
+                                                                   "(default b)."),
+    window: Optional[float] = typer.Option(None, "--contact-window", callback=_positive_option,
+                                           help="sociopatterns: seconds of one contact window (a line at t covers "
+                                                "(t-w, t]; default 20)."),
     log_fmt: str = typer.Option("csv", "--log-format", callback=_fmt_option, help="Log folder tables: csv or parquet."),
     overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
     """Convert a proximity trace into an encounter log folder (see docs/real-data.md)."""
-    from .ingest import FORMATS, ingest as read_trace
+    from .ingest import FORMATS, SOCIOPATTERNS_WINDOW, ingest as read_trace
     from .log import exact_time
 
     _check_verbosity(quiet, verbose)
     if fmt not in FORMATS:
         raise typer.BadParameter(f"{fmt!r} is not one of {', '.join(FORMATS)}", param_hint="--format")
-    log, report = read_trace(trace, fmt, skip_bad=skip_bad, time_column=time_column, a_column=a_column,
-                             b_column=b_column, window=window)
+    given = {"--time-column": time_column, "--a-column": a_column, "--b-column": b_column, "--contact-window": window}
+    for option, value in given.items():
+        formats = ("sociopatterns",) if option == "--contact-window" else ("csv", "parquet")
+        if value is not None and fmt not in formats:
+            raise typer.BadParameter(f"applies to --format {' or '.join(formats)} only", param_hint=option)
+    columns = {"time_column": time_column or "t", "a_column": a_column or "a", "b_column": b_column or "b"}
+    if len(set(columns.values())) < 3:
+        raise typer.BadParameter(f"name three different columns, not {', '.join(map(repr, columns.values()))}",
+                                 param_hint="--time-column, --a-column, --b-column")
+    log, report = read_trace(trace, fmt, skip_bad=skip_bad, **columns,
+                             window=SOCIOPATTERNS_WINDOW if window is None else window)
     written = _write_log_folder(log, out_dir, quiet, overwrite, fmt=log_fmt, protect=(trace,))
     if verbose:
         _detail(f"ingest report: {report.as_meta()}")
@@ -593,7 +618,8 @@ def plan(
     area: float = typer.Option(..., "--area", callback=_positive_option, help="Area inside the outer walls, mm^2."),
     agents: Optional[int] = typer.Option(None, "--agents", min=1, help="Swarm size N."),
     duration: Optional[float] = typer.Option(None, "--duration", callback=_positive_option, help="Seconds of data T."),
-    target: Optional[float] = typer.Option(None, "--target", help="Wanted exact-match accuracy, e.g. 0.95."),
+    target: Optional[float] = typer.Option(None, "--target", callback=_accuracy_option,
+                                           help="Wanted exact-match accuracy, e.g. 0.95."),
     holes: Optional[int] = typer.Option(None, "--holes", min=0, help="Holes the arena is expected to have "
                                         "(default: averaged over the benchmark's mix of 0-3 holes)."),
     model_file: Optional[Path] = typer.Option(None, "--model", help="plan.json of a benchmark run "

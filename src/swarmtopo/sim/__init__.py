@@ -8,7 +8,7 @@ ground truth.  Parameters and project choices: :mod:`.params`.
 
 from .params import BEHAVIOURS, Command, MotionParams, SensingParams
 from .sensing import EncounterTracker
-from .simulate import Simulation, interpreted_kernels, simulate
+from .simulate import Simulation, check_time_step, interpreted_kernels, simulate
 
 __all__ = ["BEHAVIOURS", "Command", "EncounterTracker", "MotionParams", "SensingParams", "Simulation",
-           "interpreted_kernels", "simulate"]
+           "check_time_step", "interpreted_kernels", "simulate"]

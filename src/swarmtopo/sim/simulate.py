@@ -199,15 +199,9 @@ def _check_inputs(arena, n_agents, duration, dt, motion, sensing, commands, stat
         raise InputError(f"motion must be a MotionParams, got {type(motion).__name__}")
     if not isinstance(sensing, SensingParams):
         raise InputError(f"sensing must be a SensingParams, got {type(sensing).__name__}")
-    positive("dt", dt)
+    check_time_step(dt, motion, sensing)
     non_negative("duration", duration)
     non_negative("static_time", static_time)
-    speed = max(motion.v_c, motion.v_p)
-    if speed * dt > sensing.r_d / 4:
-        raise InputError(
-            f"time step too coarse: agents move max(v_c, v_p) * dt = {speed * dt:g} mm per step, more than "
-            f"r_d / 4 = {sensing.r_d / 4:g} mm, so contacts and walls could be stepped over; "
-            f"use dt <= {sensing.r_d / (4 * speed):g} s", value=dt)
     fraction("static_fraction", static_fraction)
     for c in commands:
         if not isinstance(c, Command):
@@ -225,6 +219,18 @@ def _check_inputs(arena, n_agents, duration, dt, motion, sensing, commands, stat
         positive("trajectory_every", trajectory_every)
     if progress is not None and not callable(progress):
         raise InputError("progress must be callable or None", value=progress)
+
+
+def check_time_step(dt: float, motion: MotionParams, sensing: SensingParams) -> None:
+    """InputError unless dt > 0 and an agent moves at most r_d / 4 per step (else contacts
+    and walls could be stepped over)."""
+    positive("dt", dt)
+    speed = max(motion.v_c, motion.v_p)
+    if speed * dt > sensing.r_d / 4:
+        raise InputError(
+            f"time step too coarse: agents move max(v_c, v_p) * dt = {speed * dt:g} mm per step, more than "
+            f"r_d / 4 = {sensing.r_d / 4:g} mm, so contacts and walls could be stepped over; "
+            f"use dt <= {sensing.r_d / (4 * speed):g} s", value=dt)
 
 
 def _n_steps(duration: float, dt: float) -> int:
