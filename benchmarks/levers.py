@@ -8,8 +8,9 @@ best.  Printed per variant and per way of pooling the windows (mean scores, as t
 shipped classifier, and the lower median of the windows' counts, as before): fitted
 exact (beta_0, beta_1), the 4-fold cross-validated count (thresholds fitted without
 each quarter), per-cell counts, counts per hole family (the family of a case's holes;
-"no hole" for none) and seconds per map; then the exact count and per-cell counts when
-the maps are read by the shipped ``default`` classifier (as ``swarmtopo map`` reads a
+"no hole" for none) and seconds per map; then the exact count, per-cell counts and
+each cell's counts per hole family when the maps are read by the shipped ``default``
+classifier (as ``swarmtopo map`` reads a
 log with status changes; ``trace/`` variants' maps too, which ``map`` would read with
 the ``trace`` classifier).  Windows are never capped (``MapConfig.max_windows`` None)
 unless a variant sets the cap: the suite's maps have at most 44 windows, but variants
@@ -43,7 +44,8 @@ diffusion time, wall following x 2):
   no wall following; no r_d or speeds, so h from the data); ``trace/default`` the
   default pipeline so.
 * ``dense`` -- up to 800 landmarks, covering radius down to 1 x the k-NN scale (the
-  default: 400, 1.5 x).
+  default: 400, 1.5 x); ``cover-F[/VARIANT]`` the automatic count stopping at F x the
+  k-NN scale (``dense`` is ``cover-1/max_landmarks=800``).
 * ``diffusive-C`` -- diffusion time tau = C x the mean time between an agent's
   encounters (the default is C = ``DIFFUSION_GAP_FACTOR``; ``diffusion_time=inf`` is
   off, the paper's weights); ``switch-C`` the same with ``switch``, where D_tau applies
@@ -88,6 +90,9 @@ diffusion time, wall following x 2):
   consecutive copies joined by D_tau of the gap (wall following x 2) without h;
   Vietoris-Rips on these distances among the default's landmarks.  (``switch`` charges
   D_tau of the whole ride instead.)
+* ``pool:V1+V2+...`` -- the windows of several variants (e.g. other hop costs) pooled in
+  one region's score sequence, as the three window lengths are: an ensemble of metrics
+  over the same events (beta_0 from V1).
 * ``tcorr-S`` -- Vietoris-Rips on the landmark distances with their time separation
   taken out: within a window, events at one place but dt apart are about c + b dt
   apart (measured against the simulations' truth with ``benchmarks/metric_vs_truth.py``),
@@ -453,7 +458,21 @@ def _override(text):
     return lambda log, seed: _windows_of(log, seed, **{field: value})
 
 
+def _pooled(names):
+    """The windows of the variants ``names`` pooled per region (``pool:``); beta_0 of the first."""
+    runs = [_variant(n) for n in names]
+
+    def mapper(log, seed):
+        maps = [run(log, seed) for run in runs]
+        if len({len(regions) for regions, _ in maps}) > 1:
+            raise ValueError(f"pool:{'+'.join(names)}: the variants find different regions")
+        return [sum((list(m[0][i]) for m in maps), []) for i in range(len(maps[0][0]))], maps[0][1]
+    return mapper
+
+
 def _variant(name):
+    if name.startswith("pool:"):
+        return _pooled(name.split(":", 1)[1].split("+"))
     if "@" in name:
         base, offset = name.rsplit("@", 1)
         return lambda log, seed: _variant(base)(log, seed + int(offset))
@@ -481,6 +500,9 @@ def _variant(name):
         whole = parts[-1] == "whole"
         encounters = tuple(float(k) for k in parts[:len(parts) - whole])
         return lambda log, seed: _window_mix(log, seed, encounters, whole=whole)
+    if name.startswith("cover-"):
+        factor, _, inner = name.split("-", 1)[1].partition("/")
+        return _covering(float(factor), _variant(inner or "default"))
     if name.startswith("dtm-"):
         return lambda log, seed: _dtm(log, seed, int(name.split("-", 1)[1]))
     if name.startswith("mds-"):
@@ -500,13 +522,17 @@ def _hop_times(factor):
     return lambda log, seed: _windows_of(log, seed, hop_cost=factor * P.resolve_hop_cost(log, None)[0])
 
 
-def _dense(log, seed):
-    original = P.AUTO_COVER_FACTOR
-    P.AUTO_COVER_FACTOR = 1.0
-    try:
-        return _windows_of(log, seed, max_landmarks=800)
-    finally:
-        P.AUTO_COVER_FACTOR = original
+def _covering(factor, inner):
+    """``inner`` mapped with the automatic landmark count stopping at r_cover <= factor x
+    the k-NN scale (``cover-F``)."""
+    def mapper(log, seed):
+        original = P.AUTO_COVER_FACTOR
+        P.AUTO_COVER_FACTOR = factor
+        try:
+            return inner(log, seed)
+        finally:
+            P.AUTO_COVER_FACTOR = original
+    return mapper
 
 
 SHIPPED = load_classifier("default")
@@ -524,7 +550,7 @@ VARIANTS = {
     "hop-half": _hop_times(0.5),
     "hop-double": _hop_times(2.0),
     "hop-data": lambda log, seed: _windows_of(log, seed, hop_cost=P.HOP_GAP_FACTOR * mean_agent_gap(log)),
-    "dense": _dense,
+    "dense": _covering(1.0, lambda log, seed: _windows_of(log, seed, max_landmarks=800)),
     "mix": _window_mix,
     "hub": _hub,
 }
@@ -574,7 +600,7 @@ def main() -> None:
     parser.add_argument("--variants", nargs="+", default=["default", "20s", "whole", "quarter", "draws", "switch"],
                         help=f"{', '.join(sorted(VARIANTS))}, diffusive-C, switch-C, log-C, wall-C, wall-none, "
                              "static-F, extra-F, extra-static-F (each [/VARIANT]), smooth-HOW-K, pad-F, paths-C, dtm-K, mds-D, mix-K1-K2[-whole], draws-K[/VARIANT], trace/VARIANT, seed+D, "
-                             "tcorr-S or "
+                             "tcorr-S, pool:V1+V2+..., cover-F[/VARIANT] or "
                              "FIELD=VALUE; "
                              "VARIANT@D: with the landmark draw of seed + D")
     parser.add_argument("--cells", nargs="+", metavar="TEXT",
@@ -608,6 +634,11 @@ def main() -> None:
         per_cell = [int(sum(ok for m, ok in zip(maps, shipped) if m.cell == CELLS[c].name)) for c in cells]
         print(f"{name}, read by the shipped default classifier: {int(shipped.sum())}/{len(tasks)} exact; "
               f"per cell {per_cell}", flush=True)
+        for c in cells:
+            inside = [(f, ok) for m, f, ok in zip(maps, family_of, shipped) if m.cell == CELLS[c].name]
+            print(f"    {CELLS[c].name}: " + ", ".join(
+                f"{f} {sum(ok for g, ok in inside if g == f)}/{sum(g == f for g, _ in inside)}"
+                for f in sorted({f for f, _ in inside})), flush=True)
 
 
 if __name__ == "__main__":

@@ -77,3 +77,15 @@ def test_swarm_variants_name_their_swarm_and_inner_variant():
     agents, static, inner = levers._swarm("extra-static-0.1/wall-3", 200)
     assert (agents, inner) == (220, "wall-3") and round(static * agents) == 20  # the 20 added agents parked
     assert levers._swarm("wall-3", 300) == (300, 0.0, "wall-3")
+
+
+def test_a_pool_of_variants_concatenates_their_windows_in_order():
+    """``pool:V1+V2``: each region's windows of V1, then of V2; beta_0 of V1."""
+    log = simulate(random_arena(1, rng=3), 60, 10.0, rng=3).log
+    regions, beta0 = levers._variant("pool:max_landmarks=40+hop-double")(log, 5)
+    first, second = levers._windows_of(log, 5, max_landmarks=40), levers._variant("hop-double")(log, 5)
+    assert beta0 == first[1]
+    expected = [a + b for a, b in zip(first[0], second[0])]
+    assert [[d.lengths(1).tolist() for d in r] for r in regions] == \
+        [[d.lengths(1).tolist() for d in r] for r in expected]
+    assert len(regions[0]) == len(first[0][0]) + len(second[0][0])
