@@ -53,7 +53,7 @@ from sklearn.base import BaseEstimator
 from sklearn.linear_model import LogisticRegression
 
 from . import __version__
-from ._validate import check_format
+from ._validate import check_format, file_calibration
 from .errors import InputError, SwarmtopoError
 from .persistence import Diagram
 
@@ -407,13 +407,9 @@ def detection_scores(estimated, truth) -> DetectionScores:
 
 # -- shipped classifiers ---------------------------------------------------------------
 def _checked_calibration(calibration, source: str) -> dict:
-    """A file's calibration without the earlier files' "0" (beta_0's confidence is now the
-    pipeline's, swarmtopo.beta0); each dimension's model must hold the numbers it is
-    applied with, and "maps" must be a count."""
-    if not isinstance(calibration, dict):
-        raise InputError("must be an object of {dimension: model}", file=source, column="calibration",
-                         value=calibration)
-    out = {n: c for n, c in calibration.items() if n != "0"}
+    """A file's calibration (:func:`file_calibration`); each dimension's model must hold
+    the numbers it is applied with, and "maps" must be a count."""
+    out = file_calibration(calibration, source)
     for n, model in out.items():
         if n == "maps":
             ok = isinstance(model, int) and not isinstance(model, bool) and model >= 0

@@ -57,7 +57,7 @@ import pyarrow.csv as pcsv
 import pyarrow.parquet as pq
 
 from .errors import InputError, SwarmtopoError
-from .io import _GZIP_MAGIC, _SNIFF_BYTES, coarse_time, integer_ids, non_utf8_problem, refuse_binary
+from .io import GZIP_MAGIC, SNIFF_BYTES, coarse_time, integer_ids, non_utf8_problem, refuse_binary
 from .log import MAX_TIME, TOO_LATE, EncounterLog
 
 FORMATS: tuple[str, ...] = ("csv", "parquet", "sociopatterns", "one")
@@ -431,7 +431,7 @@ def _csv_bytes(path: Path) -> pa.NativeFile:
     """The CSV file's bytes: gunzipped if it is gzip, by content as the text formats (other
     compressions by name, as pyarrow detects them)."""
     with open(path, "rb") as f:
-        gzipped = f.read(2) == _GZIP_MAGIC
+        gzipped = f.read(2) == GZIP_MAGIC
     return pa.input_stream(str(path), compression="gzip" if gzipped else "detect")
 
 
@@ -443,7 +443,7 @@ def _check_csv_text(path: Path) -> None:
     """
     try:
         with _csv_bytes(path) as f:
-            head = f.read(_SNIFF_BYTES)
+            head = f.read(SNIFF_BYTES)
             refuse_binary(path, head)
             problem = non_utf8_problem(itertools.chain([head], iter(lambda: f.read(_BLOCK), b"")))
     except (OSError, pa.ArrowInvalid) as exc:  # a truncated or corrupt .gz

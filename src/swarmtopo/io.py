@@ -77,8 +77,8 @@ _OTHER_ENCODINGS = ((b"\xff\xfe\x00\x00", "UTF-32"), (b"\x00\x00\xfe\xff", "UTF-
 _INTEGER_TEXT = r"^(0|-?[1-9][0-9]*)(\.0+)?$"
 """An ID written as an integer: plain (not 017, not -0: those stay text), or with a zero
 fraction, as a float column is often written (12.0 is agent 12, as in a Parquet float column)."""
-_GZIP_MAGIC = b"\x1f\x8b"
-_SNIFF_BYTES = 1 << 16  # the first block of a CSV file checked for binary data
+GZIP_MAGIC = b"\x1f\x8b"
+SNIFF_BYTES = 1 << 16  # the first block of a CSV file checked for binary data
 MAX_TIME_RESOLUTION = 1e-3
 """Coarsest spacing (s) a float16 / float32 time column may have at its largest value:
 beyond it the file's times were already rounded when written (float32 epoch seconds are
@@ -564,7 +564,7 @@ def _read_table(path: Path, required: tuple[str, ...], *, keep_all: bool = False
 def _csv_header(path: Path) -> list[str]:
     try:
         with open(path, "rb") as f:
-            refuse_binary(path, f.read(_SNIFF_BYTES))
+            refuse_binary(path, f.read(SNIFF_BYTES))
         with pcsv.open_csv(path, read_options=pcsv.ReadOptions(block_size=1 << 16)) as reader:
             return reader.schema.names
     except UnicodeDecodeError as exc:
@@ -584,7 +584,7 @@ def refuse_binary(path: Path, head: bytes) -> None:
         if head.startswith(bom):
             raise InputError(f"not UTF-8 text: it starts with the byte-order mark of {encoding}; save it as UTF-8",
                              file=str(path))
-    if head.startswith(_GZIP_MAGIC):
+    if head.startswith(GZIP_MAGIC):
         raise InputError("gzip-compressed: gunzip it first", file=str(path))
     nul = head.find(b"\0")
     if nul >= 0:

@@ -70,7 +70,7 @@ from scipy.special import expit
 from sklearn.linear_model import LogisticRegression
 
 from . import __version__
-from ._validate import check_format
+from ._validate import check_format, file_calibration
 from .agreement import BARS, agreement_array
 from .errors import InputError, SwarmtopoError
 from .persistence import Diagram
@@ -289,7 +289,7 @@ class RatioClassifier:
                 raise InputError("an agreement gate needs dimension 1, mean pooling and 0 <= agreement < 1",
                                  column=f"thresholds.{n}.agreement", value=th.agreement)
         for n, model in (calibration or {}).items():
-            unknown = set(model) - {"intercept", "maps", *REGION_FEATURES} if isinstance(model, dict) else set()
+            unknown = set(model) - {"intercept", "maps", *REGION_FEATURES} if isinstance(model, dict) else ()
             if unknown:
                 raise InputError(f"unknown confidence feature(s) {sorted(unknown)}; known: "
                                  f"{', '.join(REGION_FEATURES)}", column=f"calibration.{n}", value=model)
@@ -492,11 +492,7 @@ class RatioClassifier:
                 gate = t.get("agreement") if obj["format"] == RATIO_FORMAT else None  # checked by __init__
                 thresholds[int(n)] = RatioThresholds(float(t["q"]), float(t["tau"]), gate)
             pooling = obj.get("pooling", "mean") if obj["format"] in READ_FORMATS[2:] else "median"
-            if not isinstance(obj.get("calibration") or {}, dict):
-                raise InputError("must be an object of {dimension: model}", column="calibration",
-                                 value=obj["calibration"])
-            # "0": earlier files' beta_0 rate; beta_0's confidence is now the pipeline's (swarmtopo.beta0)
-            calibration = {n: c for n, c in (obj.get("calibration") or {}).items() if n != "0"}
+            calibration = file_calibration(obj.get("calibration"), source)
             return cls(thresholds, calibration or None, obj.get("provenance") or {}, pooling)
         except InputError as exc:
             if exc.file is not None:
