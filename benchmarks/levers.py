@@ -444,9 +444,9 @@ def _padded(log, seed, factor):
         P.build_graph, P._map_window, P._subsample = original_build, original_map, original_subsample
 
 
-def _override(text):
-    """The variant ``FIELD=VALUE``: MapConfig(FIELD=VALUE), VALUE read as the field's default's type
-    (a tuple from comma-separated numbers: ``window_scales=0.75,1``)."""
+def config_override(text: str) -> dict:
+    """``FIELD=VALUE`` as ``{FIELD: VALUE}`` for MapConfig, VALUE read as the field's
+    default's type (a tuple from comma-separated numbers: ``window_scales=0.75,1``)."""
     field, text = text.split("=", 1)
     default = getattr(MapConfig(), field)
     if isinstance(default, str):
@@ -455,7 +455,13 @@ def _override(text):
         value = tuple(float(x) for x in text.split(","))
     else:
         value = float(text) if default is None else type(default)(float(text))
-    return lambda log, seed: _windows_of(log, seed, **{field: value})
+    return {field: value}
+
+
+def _override(text):
+    """The variant ``FIELD=VALUE``: MapConfig(FIELD=VALUE) (:func:`config_override`)."""
+    options = config_override(text)
+    return lambda log, seed: _windows_of(log, seed, **options)
 
 
 def _pooled(names):

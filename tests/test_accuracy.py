@@ -61,6 +61,26 @@ def test_cases_cover_the_cells_draws():
     assert {acc.cell_of(j.config) for j in reporting} == {c.name for c in acc.CELLS}
 
 
+def test_planning_grid_has_cases_of_its_own_and_varies_swarm_size_and_duration_apart():
+    planning = acc.planning_jobs()
+    assert len(planning) == len(acc.PLANNING_CELLS) * acc.PLANNING_PER_CELL
+    seeds = {j.case_seed for j in planning}
+    suite_seeds = {acc.case_seed(c, split, i) for c in acc.CELLS for split, n in
+                   (("tuning", acc.TUNING_PER_CELL), ("reporting", acc.REPORTING_PER_CELL)) for i in range(n)}
+    assert len(seeds) == len(planning) and not seeds & suite_seeds
+    assert {j.config["map"]["classifier"] for j in planning} == {"default"}
+    scales = np.array([j.config["arena"]["scale"] for j in planning])
+    assert acc.PLANNING_SCALE_RANGE[0] <= scales.min() and scales.max() <= acc.PLANNING_SCALE_RANGE[1]
+    assert scales.max() > acc.SCALE_RANGE[1]  # arenas beyond the suite's
+    # every swarm size is run at every duration (the suite's budgets tie them together)
+    budgets = {(j.config["swarm"]["agents"], j.config["swarm"]["duration"]) for j in planning}
+    assert budgets == set(acc.PLANNING_BUDGETS) and len({n for n, _ in budgets}) * len({t for _, t in budgets}) == len(budgets)
+    # a planning case of the suite's smallest budget is named by its own cell, not the suite's
+    small = next(j for j in planning if (j.config["swarm"]["agents"], j.config["swarm"]["duration"]) == (200, 30.0))
+    assert acc.cell_of(small.config, acc.PLANNING_CELLS).startswith("planning: ")
+    assert not acc.cell_of(small.config).startswith("planning")  # the default cells are the suite's
+
+
 def test_table_and_reliability_hand_computed():
     records = [{"cell": acc.CELLS[0].name, "held_out": False, "right": True, "betti1_right": True,
                 "confidence_betti1": 0.9} for _ in range(3)]

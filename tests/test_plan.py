@@ -45,6 +45,35 @@ def test_fit_recovers_the_law_it_was_drawn_from():
     assert model.accuracy(1e6, 300, 40) == pytest.approx(np.mean([sigmoid(z - 0.8 * h) for h in range(4)]), abs=0.04)
 
 
+def test_fit_tells_swarm_size_from_density_when_they_vary_apart():
+    """Drawn from a law with a ln N term of its own (c4 = 1.0) besides density and time:
+    the fit recovers it, and without the term (the /2 form) it cannot."""
+    rng = np.random.default_rng(3)
+    records = []
+    for _ in range(4000):
+        area = rng.uniform(0.1e6, 1.0e6)
+        agents = int(rng.integers(100, 800))
+        duration = rng.uniform(15, 120)
+        holes = int(rng.integers(0, 4))
+        z = 0.5 + 0.8 * np.log(agents / area * 1e4) + 0.6 * np.log(duration / 30) + 1.0 * np.log(agents / 300) - 0.8 * holes
+        records.append({"area": area, "agents": agents, "duration": duration, "true_betti1": holes,
+                        "right": bool(rng.random() < sigmoid(z))})
+    model = fit_plan(records, source="test")
+    assert model.agents_coef == pytest.approx(1.0, abs=0.3)
+    assert model.density_coef == pytest.approx(0.8, abs=0.3)
+    assert model.duration_coef == pytest.approx(0.6, abs=0.3)
+    # a small swarm as dense as a big one: the law says it maps worse, and so does the model
+    z_small = 0.5 + 0.8 * np.log(100 / 0.1e6 * 1e4) + 0.6 * np.log(40 / 30) + 1.0 * np.log(100 / 300)
+    assert model.accuracy(0.1e6, 100, 40, holes=0) == pytest.approx(sigmoid(z_small), abs=0.05)
+    assert fit_plan(records, source="test", swarm_size=False).agents_coef == 0.0
+    # the inverse answer for N accounts for both terms
+    n = model.agents_for(0.5e6, 40, 0.9, holes=1)
+    assert model.accuracy(0.5e6, n, 40, holes=1) == pytest.approx(0.9)
+    closed = np.exp((np.log(0.9 / 0.1) - model.intercept - model.duration_coef * np.log(40) - model.holes_coef
+                     + model.density_coef * np.log(0.5e6)) / (model.density_coef + model.agents_coef))
+    assert n == pytest.approx(closed, rel=1e-6)
+
+
 def test_unknown_holes_average_over_the_mix_and_more_holes_need_more_data():
     model = PlanModel(-3.0, 1.2, 1.8, (1e-4, 1e-3), (30, 60), 100, "test", -0.5, (0.5, 0.25, 0.25))
     per_hole = [model.accuracy(250_000, 200, 30, holes=h) for h in range(3)]
@@ -70,6 +99,15 @@ def test_inverse_answers_invert_the_forward_one():
     assert model.agents_for(250_000, 40, 0.9) == pytest.approx(closed, rel=1e-6)
     flat = PlanModel(0.0, 0.0, -1.0, (1e-4, 1e-3), (30, 60), 100, "test")
     assert flat.agents_for(1, 1, 0.9) == np.inf and flat.duration_for(1, 1, 0.9) == np.inf
+
+
+def test_format_2_files_read_without_a_swarm_size_term(tmp_path):
+    model = PlanModel(-3.0, 1.2, 1.8, (1e-4, 1e-3), (30, 60), 100, "test", -0.5, (0.25,) * 4, (200.0, 400.0))
+    old = {**model.to_json(), "format": "swarmtopo-plan/2"}
+    del old["agents_coef"]
+    path = tmp_path / "old.json"
+    path.write_text(json.dumps(old))
+    assert load_plan(path) == model and load_plan(path).agents_coef == 0.0
 
 
 def test_format_1_files_read_without_a_hole_term_and_bad_mixes_are_refused(tmp_path):

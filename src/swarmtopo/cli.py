@@ -604,7 +604,7 @@ def bench_accuracy(
     (out_dir / "accuracy.md").write_text(text, encoding="utf-8")
     written.append(out_dir / "accuracy.md")
     try:
-        written.append(write_json(fit_plan(summary["records"], source=command).to_json(), out_dir / "plan.json"))
+        written.append(write_json(fit_plan(summary["records"], source=command, swarm_size=False).to_json(), out_dir / "plan.json"))
     except SwarmtopoError as exc:
         _warn(f"no plan.json: {exc}", quiet)
     if not quiet:

@@ -1,21 +1,24 @@
 """Planning a deployment from the accuracy benchmark: what accuracy a swarm will get.
 
-The model is fitted by ``swarmtopo bench accuracy`` on its reporting maps of the
-default pipeline and shipped as ``swarmtopo/data/plan.json``: a logistic regression of
-"(beta_0, beta_1) exactly right" on ln(agent density N / A), ln(duration T) and the
-number of holes H,
+The model is fitted by ``scripts/fit_plan.py`` on the default pipeline's maps of the
+benchmark's reporting cases and of its planning grid (``experiments.accuracy``:
+100-800 agents x 15-120 s in 0.14-1 m^2), and shipped as ``swarmtopo/data/plan.json``:
+a logistic regression of "(beta_0, beta_1) exactly right" on ln(agent density N / A),
+ln(duration T), ln(swarm size N) and the number of holes H,
 
-    P(right | A, N, T, H) = sigmoid(c0 + c1 ln(N / A) + c2 ln T + c3 H)
+    P(right | A, N, T, H) = sigmoid(c0 + c1 ln(N / A) + c2 ln T + c4 ln N + c3 H)
 
-(A in mm^2 inside the outer walls, N agents, T seconds).  Arena size enters only
-through the density: the suite varies the scale of every case, so maps of the same
-swarm size in bigger arenas are sparser.  A team that does not know H gets the
-average over the benchmark's mix of hole counts (``PlanModel.holes_mix``).  The
-inverse questions solve the same equation for N or T.  The benchmark spans a range
-of densities, durations and hole counts (``density_range``, ``duration_range``,
-``len(holes_mix) - 1``, and the swarm sizes ``agents_range``); answers outside it are
-extrapolations and say so.  Format /1 files (no hole term) are read with c3 = 0; files
-without ``agents_range`` check no swarm size.
+(A in mm^2 inside the outer walls, N agents, T seconds).  The swarm size has a term of
+its own because a map's windows hold about N x 10 events whatever the arena: a small
+swarm in a small arena is as dense as a large one and maps worse.  The reporting
+cases alone cannot tell N from T (their budgets raise both together); the planning
+grid varies each on its own.  A team that does not know H gets the average over the
+benchmark's mix of hole counts (``PlanModel.holes_mix``).  The inverse questions
+solve the same equation for N or T.  The fit spans a range of densities, durations,
+swarm sizes and hole counts (``density_range``, ``duration_range``, ``agents_range``,
+``len(holes_mix) - 1``); answers outside it are extrapolations and say so.  Format /1
+files (no hole term) are read with c3 = 0, files before /3 with c4 = 0; files without
+``agents_range`` check no swarm size.
 """
 
 from __future__ import annotations
@@ -34,15 +37,16 @@ from sklearn.linear_model import LogisticRegression
 from ._validate import check_format, positive
 from .errors import InputError, SwarmtopoError
 
-PLAN_FORMAT = "swarmtopo-plan/2"
-READ_FORMATS = ("swarmtopo-plan/1", PLAN_FORMAT)
+PLAN_FORMAT = "swarmtopo-plan/3"
+READ_FORMATS = ("swarmtopo-plan/1", "swarmtopo-plan/2", PLAN_FORMAT)
 LOG_SPAN = 50.0
 """How far (in ln units) beyond the benchmark's range the inverse answers search."""
 
 
 @dataclass(frozen=True)
 class PlanModel:
-    """P(right) = sigmoid(intercept + density_coef ln(N/A) + duration_coef ln T + holes_coef H)."""
+    """P(right) = sigmoid(intercept + density_coef ln(N/A) + duration_coef ln T
+    + agents_coef ln N + holes_coef H)."""
 
     intercept: float
     density_coef: float
@@ -54,26 +58,27 @@ class PlanModel:
     holes_coef: float = 0.0
     holes_mix: tuple[float, ...] = (1.0,)  # fraction of the benchmark's maps with 0, 1, 2, ... holes
     agents_range: tuple[float, float] | None = None  # swarm sizes the benchmark ran (None: not recorded)
+    agents_coef: float = 0.0
 
     def accuracy(self, area: float, agents: float, duration: float, holes: int | None = None) -> float:
         """Expected exact-match accuracy of the default pipeline with ``holes`` holes
         (None: averaged over the benchmark's mix of hole counts)."""
         _check_positive(area=area, agents=agents, duration=duration)
-        return self._accuracy(np.log(agents / area), np.log(duration), holes)
+        return self._accuracy(np.log(agents), np.log(area), np.log(duration), holes)
 
     def agents_for(self, area: float, duration: float, target: float, holes: int | None = None) -> float:
         """Agents N needed for ``target`` accuracy (inf if more agents do not help)."""
         _check_positive(area=area, duration=duration)
-        log_t = np.log(duration)
-        log_density = self._solve(lambda x: self._accuracy(x, log_t, holes), self.density_coef,
-                                  np.log(self.density_range), target)
-        return float(area * np.exp(log_density))
+        log_a, log_t = np.log(area), np.log(duration)
+        log_n = self._solve(lambda x: self._accuracy(x, log_a, log_t, holes), self.density_coef + self.agents_coef,
+                            np.log(self.density_range) + log_a, target)
+        return float(np.exp(log_n))
 
     def duration_for(self, area: float, agents: float, target: float, holes: int | None = None) -> float:
         """Seconds T needed for ``target`` accuracy (inf if more time does not help)."""
         _check_positive(area=area, agents=agents)
-        log_density = np.log(agents / area)
-        log_t = self._solve(lambda x: self._accuracy(log_density, x, holes), self.duration_coef,
+        log_n, log_a = np.log(agents), np.log(area)
+        log_t = self._solve(lambda x: self._accuracy(log_n, log_a, x, holes), self.duration_coef,
                             np.log(self.duration_range), target)
         return float(np.exp(log_t))
 
@@ -85,8 +90,9 @@ class PlanModel:
                 and self.duration_range[0] <= duration <= self.duration_range[1]
                 and (holes is None or holes < len(self.holes_mix)))
 
-    def _accuracy(self, log_density: float, log_duration: float, holes: int | None) -> float:
-        base = self.intercept + self.density_coef * log_density + self.duration_coef * log_duration
+    def _accuracy(self, log_agents: float, log_area: float, log_duration: float, holes: int | None) -> float:
+        base = (self.intercept + self.density_coef * (log_agents - log_area) + self.duration_coef * log_duration
+                + self.agents_coef * log_agents)
         if holes is not None:
             if holes < 0:
                 raise InputError("the number of holes must be >= 0", column="holes", value=holes)
@@ -109,6 +115,7 @@ class PlanModel:
                 "duration_coef": self.duration_coef, "holes_coef": self.holes_coef,
                 "holes_mix": list(self.holes_mix), "density_range": list(self.density_range),
                 "duration_range": list(self.duration_range), "maps": self.maps, "source": self.source,
+                "agents_coef": self.agents_coef,
                 **({} if self.agents_range is None else {"agents_range": list(self.agents_range)})}
 
     @classmethod
@@ -119,7 +126,8 @@ class PlanModel:
                         tuple(map(float, obj["density_range"])), tuple(map(float, obj["duration_range"])),
                         int(obj["maps"]), str(obj["source"]), float(obj.get("holes_coef", 0.0)),
                         tuple(map(float, obj.get("holes_mix", (1.0,)))),
-                        tuple(map(float, obj["agents_range"])) if "agents_range" in obj else None)
+                        tuple(map(float, obj["agents_range"])) if "agents_range" in obj else None,
+                        float(obj.get("agents_coef", 0.0)))
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"malformed plan model: {exc!r}", file=source) from None
         for name in ("density_range", "duration_range", "agents_range"):
@@ -133,23 +141,25 @@ class PlanModel:
         return model
 
 
-def fit_plan(records: Sequence[dict[str, Any]], source: str) -> PlanModel:
-    """The plan model of the benchmark's reporting records (``area``, ``agents``,
-    ``duration``, ``true_betti1``, ``right``), by a lightly regularised logistic regression."""
-    density = np.array([r["agents"] / r["area"] for r in records], dtype=float)
+def fit_plan(records: Sequence[dict[str, Any]], source: str, *, swarm_size: bool = True) -> PlanModel:
+    """The plan model of benchmark records (``area``, ``agents``, ``duration``,
+    ``true_betti1``, ``right``), by a lightly regularised logistic regression;
+    ``swarm_size=False`` leaves out the ln N term (c4 = 0: the format /2 model)."""
+    agents = np.array([r["agents"] for r in records], dtype=float)
+    density = agents / np.array([r["area"] for r in records], dtype=float)
     duration = np.array([r["duration"] for r in records], dtype=float)
     holes = np.array([r["true_betti1"] for r in records], dtype=int)
     right = np.array([r["right"] for r in records], dtype=bool)
     if len(np.unique(right)) < 2:
         raise SwarmtopoError("the plan needs both right and wrong maps to fit (every map had the same outcome)")
-    X = np.column_stack([np.log(density), np.log(duration), holes])
+    X = np.column_stack([np.log(density), np.log(duration), holes] + ([np.log(agents)] if swarm_size else []))
     model = LogisticRegression(C=10.0).fit(X, right)
     mix = np.bincount(holes) / len(holes)
-    agents = np.array([r["agents"] for r in records], dtype=float)
-    return PlanModel(float(model.intercept_[0]), float(model.coef_[0, 0]), float(model.coef_[0, 1]),
+    coef = model.coef_[0]
+    return PlanModel(float(model.intercept_[0]), float(coef[0]), float(coef[1]),
                      (float(density.min()), float(density.max())), (float(duration.min()), float(duration.max())),
-                     int(len(right)), source, float(model.coef_[0, 2]), tuple(float(w) for w in mix),
-                     (float(agents.min()), float(agents.max())))
+                     int(len(right)), source, float(coef[2]), tuple(float(w) for w in mix),
+                     (float(agents.min()), float(agents.max())), float(coef[3]) if swarm_size else 0.0)
 
 
 def load_plan(path: str | Path | None = None) -> PlanModel:

@@ -74,19 +74,33 @@ classifier form trained our way: the ``paper-form`` preset)."""
 
 @dataclass(frozen=True)
 class Cell:
-    """One row of the table: a hole count (None: two rooms with 0-2 holes) and a budget."""
+    """One row of the table: a hole count (None: two rooms with 0-2 holes), a budget and
+    the range the scale of its cases is drawn from."""
 
     name: str
     generator: str
     holes: int | None
     agents: int
     duration: float
+    scale_range: tuple[float, float] = SCALE_RANGE
 
 
 CELLS: tuple[Cell, ...] = (
     *(Cell(f"{h} holes, {n} x {t:g} s", "random", h, n, t) for h in range(4) for n, t in BUDGETS),
     Cell(f"two rooms, {TWO_ROOMS_BUDGET[0]} x {TWO_ROOMS_BUDGET[1]:g} s", "two_rooms", None, *TWO_ROOMS_BUDGET),
 )
+
+PLANNING_BUDGETS: tuple[tuple[int, float], ...] = tuple((n, t) for n in (100, 200, 400, 800) for t in (15.0, 30.0, 60.0, 120.0))
+"""Budgets of the planning grid: swarm size and duration each varied on its own, which
+the suite's budgets (both rising together) cannot tell apart."""
+PLANNING_SCALE_RANGE = (0.75, 2.0)
+"""Scales of the planning grid's arenas: areas 0.14-1 m^2, so density varies on its own too."""
+PLANNING_CELLS: tuple[Cell, ...] = tuple(
+    Cell(f"planning: {h} holes, {n} x {t:g} s", "random", h, n, t, PLANNING_SCALE_RANGE)
+    for h in range(4) for n, t in PLANNING_BUDGETS)
+"""The planning grid: cases ``plan`` is fitted on besides the reporting cases (split
+"planning", seeds of their own; all five hole families; no default is chosen on them)."""
+PLANNING_PER_CELL = 3
 
 _session = {"tuning": False}
 
@@ -115,7 +129,7 @@ def case_arena(cell: Cell, split: str, index: int, attempt: int = 0) -> dict[str
     families = [s for s in HOLE_SHAPES if split == "reporting" or s != HELD_OUT_FAMILY]
     holes = int(rng.integers(0, 3)) if cell.holes is None else cell.holes
     shapes = [families[int(rng.integers(len(families)))]]  # one family for all the case's holes
-    scale = float(np.round(rng.uniform(*SCALE_RANGE), 4))
+    scale = float(np.round(rng.uniform(*cell.scale_range), 4))
     arena: dict[str, Any] = {"generator": cell.generator, "holes": holes, "shapes": shapes, "scale": scale}
     if cell.generator == "random":
         arena["outer"] = OUTER_SHAPES[int(rng.integers(len(OUTER_SHAPES)))]
@@ -183,16 +197,22 @@ def reporting_jobs(per_cell: int = REPORTING_PER_CELL, pipelines=None, cells=CEL
     return _jobs("reporting", per_cell, pipelines or PIPELINES, cells)
 
 
+def planning_jobs(per_cell: int = PLANNING_PER_CELL, cells=PLANNING_CELLS) -> list[Job]:
+    """Jobs of the planning grid under the default pipeline (what ``plan`` is fitted on
+    besides the reporting maps: ``scripts/fit_plan.py``)."""
+    return _jobs("planning", per_cell, {"default": PIPELINES["default"]}, cells)
+
+
 def has_held_out_family(config: dict[str, Any]) -> bool:
     """Whether a case's arena has holes of ``HELD_OUT_FAMILY``."""
     arena = config["arena"]
     return arena.get("holes", 0) > 0 and HELD_OUT_FAMILY in arena.get("shapes", ())
 
 
-def cell_of(config: dict[str, Any]) -> str:
-    """The cell name of a job's config."""
+def cell_of(config: dict[str, Any], cells=CELLS) -> str:
+    """The name of the cell among ``cells`` a job's config is a case of."""
     arena, swarm = config["arena"], config["swarm"]
-    for cell in CELLS:
+    for cell in cells:
         if (cell.generator == arena["generator"] and cell.agents == swarm["agents"]
                 and cell.duration == swarm["duration"] and cell.holes in (None, arena.get("holes"))):
             return cell.name
@@ -222,8 +242,8 @@ class Rate:
         return {"right": self.right, "total": self.total, "rate": self.rate, "wilson95": list(self.interval)}
 
 
-def outcomes(rows, classifier) -> list[dict[str, Any]]:
-    """One record per reporting row: cell, held-out family, truth, estimate,
+def outcomes(rows, classifier, cells=CELLS) -> list[dict[str, Any]]:
+    """One record per row (of a case of ``cells``): cell, held-out family, truth, estimate,
     confidences, and whether (beta_0, beta_1) is exactly right.
 
     beta_1 and its confidence are read from the row's stored per-window diagrams by
@@ -250,7 +270,7 @@ def outcomes(rows, classifier) -> list[dict[str, Any]]:
             conf0 = row["confidence_betti0"]
         right = row["error"] is None and est0 == row["true_betti0"] and est1 == row["true_betti1"]
         records.append({
-            "cell": cell_of(config), "index": row["replicate"], "held_out": has_held_out_family(config),
+            "cell": cell_of(config, cells), "index": row["replicate"], "held_out": has_held_out_family(config),
             "agents": config["swarm"]["agents"], "duration": config["swarm"]["duration"],
             "area": case_area(config), "true_betti0": row["true_betti0"], "true_betti1": row["true_betti1"],
             "est_betti0": est0, "est_betti1": est1, "confidence_betti0": conf0, "confidence_betti1": conf1,
