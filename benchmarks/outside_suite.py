@@ -8,9 +8,8 @@ three budgets raise swarm size and duration together (200 x 30 s, 300 x 40 s,
 maps arenas drawn the same way (holes 0-3 in turn, a random family among all five, a
 random outer wall) under regimes outside those ranges -- a larger arena, a sparse or a
 dense swarm, a long or a short log, other detection radii, faster agents, longer wall
-following, static nodes -- and a grid of budgets (``budget N x T``: 100-800 agents,
-15-120 s, the suite's scale draw), each from a log stripped of ground truth, as
-``swarmtopo map`` reads a deployment's folder.  The seeds come from their own
+following, static nodes -- each from a log stripped of ground truth, as ``swarmtopo
+map`` reads a deployment's folder.  The seeds come from their own
 namespace (``NAMESPACE``), so no case is a suite case.
 
 Prints per regime: exact (beta_0, beta_1) with its Wilson 95 % interval, what the
@@ -19,8 +18,7 @@ paper's motion and sensing only), the wrong maps as (true -> mapped, beta_1
 confidence), the mean beta_1 confidence of the right and of the wrong maps, events per
 log and seconds per map.
 
-    python benchmarks/outside_suite.py [--per-regime 12] [--first 0] [--regimes NAME ...] [--set FIELD=VALUE ...]\
-        [--records OUT.json]
+    python benchmarks/outside_suite.py [--per-regime 12] [--first 0] [--regimes NAME ...] [--set FIELD=VALUE ...]
 
 ``--first`` is the index of the first case of each regime (``--first 12`` the next
 twelve); ``--set`` maps with ``MapConfig`` fields changed (as
@@ -31,17 +29,15 @@ from __future__ import annotations
 
 import argparse
 import hashlib
-import json
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from swarmtopo.arena import HOLE_SHAPES, OUTER_SHAPES, random_arena
 from swarmtopo.errors import SwarmtopoError
-from swarmtopo.experiments.accuracy import ROOM_SIDE, SCALE_RANGE, Rate
+from swarmtopo.experiments.accuracy import ROOM_SIDE, Rate
 from swarmtopo.experiments.sweep import stripped_log
 from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.plan import load_plan
@@ -56,11 +52,11 @@ NAMESPACE = "swarmtopo-outside-suite/1"
 @dataclass(frozen=True)
 class Regime:
     """A swarm and arena size outside the suite's: ``scale`` multiplies the suite's
-    500 mm arena (None: the suite's draw, uniform in ``SCALE_RANGE``)."""
+    500 mm arena (one value, not the suite's draw)."""
 
     agents: int
     duration: float
-    scale: float | None = 1.0
+    scale: float = 1.0
     r_d: float = 30.0
     motion: dict = field(default_factory=dict)
     static_fraction: float = 0.0
@@ -83,7 +79,6 @@ REGIMES = {
     "faster agents: v_c 30, v_p 20 mm/s, 300 x 40 s": Regime(300, 40.0, motion={"v_c": 30.0, "v_p": 20.0}),
     "long wall following: tau_exit 40 s, 300 x 40 s": Regime(300, 40.0, motion={"tau_exit": 40.0}),
     "static nodes: 20 % stopped from t = 0, 300 x 40 s": Regime(300, 40.0, static_fraction=0.2),
-    **{f"budget {n} x {t} s": Regime(n, float(t), scale=None) for n in (100, 200, 400, 800) for t in (15, 30, 60, 120)},
 }
 """The small arena keeps the suite's ratio of r_d to the arena (30 mm to 500 mm), so its
 passages (the 60 mm clearance x 0.6) stay twice r_d; its swarm keeps the suite's density."""
@@ -102,12 +97,11 @@ def _arena(regime_name: str, regime: Regime, index: int):
         rng = np.random.default_rng(seed)
         family = HOLE_SHAPES[int(rng.integers(len(HOLE_SHAPES)))]
         outer = OUTER_SHAPES[int(rng.integers(len(OUTER_SHAPES)))]
-        scale = float(rng.uniform(*SCALE_RANGE)) if regime.scale is None else regime.scale
         try:
-            arena = random_arena(index % 4, scale=scale, shapes=(family,), outer=outer, rng=rng)
+            arena = random_arena(index % 4, scale=regime.scale, shapes=(family,), outer=outer, rng=rng)
         except SwarmtopoError:
             continue
-        return arena, seed, family, (ROOM_SIDE * scale) ** 2
+        return arena, seed, family, (ROOM_SIDE * regime.scale) ** 2
     raise SwarmtopoError(f"{regime_name}: no placeable arena for case {index}")
 
 
@@ -127,13 +121,8 @@ def _run(task):
         mapped, confidence = (tmap.betti[0], tmap.betti[1]), tmap.confidence[1]
     except SwarmtopoError as error:  # a log the pipeline refuses is a wrong map, with its reason
         mapped, confidence = (str(error)[:80], None), None
-    expected = (load_plan().accuracy(area, regime.agents, regime.duration, arena.betti[1])
-                if regime.paper_swarm else None)
-    record = {"regime": regime_name, "index": index, "area": area, "agents": regime.agents,
-              "duration": regime.duration, "true_betti1": arena.betti[1], "right": mapped == tuple(arena.betti),
-              "paper_swarm": regime.paper_swarm}
-    return (regime_name, index, family, tuple(arena.betti), mapped, confidence, log.n_events,
-            time.perf_counter() - start, expected, record)
+    return {"regime": regime_name, "family": family, "area": area, "truth": tuple(arena.betti), "mapped": mapped,
+            "confidence": confidence, "events": log.n_events, "seconds": time.perf_counter() - start}
 
 
 def main() -> None:
@@ -143,33 +132,33 @@ def main() -> None:
     parser.add_argument("--regimes", nargs="*", default=list(REGIMES), help="regime names (a prefix is enough)")
     parser.add_argument("--set", nargs="*", default=[], metavar="FIELD=VALUE", help="MapConfig fields to change")
     parser.add_argument("--processes", type=int, default=2)
-    parser.add_argument("--records", help="also write every map's outcome as JSON (plan's record fields)")
     args = parser.parse_args()
     options = {k: v for text in args.set for k, v in config_override(text).items()}
     names = [n for n in REGIMES if any(n.startswith(p) for p in args.regimes)]
     tasks = [(name, i, options) for name in names for i in range(args.first, args.first + args.per_regime)]
     with ProcessPoolExecutor(args.processes) as pool:
         results = list(pool.map(_run, tasks))
+    plan = load_plan()
     total = 0
     for name in names:
-        rows = [r for r in results if r[0] == name]
-        right = [r for r in rows if r[3] == r[4]]
-        low, high = Rate(len(right), len(rows)).interval
+        regime = REGIMES[name]
+        rows = [r for r in results if r["regime"] == name]
+        right = [r for r in rows if r["truth"] == r["mapped"]]
+        wrong = [r for r in rows if r["truth"] != r["mapped"]]
         total += len(right)
-        wrong = ", ".join(f"{r[2]} {r[3][1]}->{r[4][1]} ({'-' if r[5] is None else f'{r[5]:.2f}'})"
-                          for r in rows if r[3] != r[4])
-        conf_right = [r[5] for r in right if r[5] is not None]
-        conf_wrong = [r[5] for r in rows if r[3] != r[4] and r[5] is not None]
-        expected = [r[8] for r in rows if r[8] is not None]
-        plan = f"plan expects {np.mean(expected):.2f}; " if expected else ""
-        print(f"{name}: {len(right)}/{len(rows)} exact [{low:.2f}, {high:.2f}]; {plan}"
+        low, high = Rate(len(right), len(rows)).interval
+        expected = (f"plan expects {np.mean([plan.accuracy(r['area'], regime.agents, regime.duration, r['truth'][1]) for r in rows]):.2f}; "
+                    if regime.paper_swarm else "")
+        conf_right = [r["confidence"] for r in right if r["confidence"] is not None]
+        conf_wrong = [r["confidence"] for r in wrong if r["confidence"] is not None]
+        listed = ", ".join(f"{r['family']} {r['truth'][1]}->{r['mapped'][1]} "
+                           f"({'-' if r['confidence'] is None else format(r['confidence'], '.2f')})" for r in wrong)
+        print(f"{name}: {len(right)}/{len(rows)} exact [{low:.2f}, {high:.2f}]; {expected}"
               f"beta_1 confidence right {np.mean(conf_right) if conf_right else float('nan'):.2f}, "
               f"wrong {np.mean(conf_wrong) if conf_wrong else float('nan'):.2f}; "
-              f"{int(np.median([r[6] for r in rows]))} events, {np.mean([r[7] for r in rows]):.1f} s per map"
-              + (f"\n    wrong: {wrong}" if wrong else ""))
+              f"{int(np.median([r['events'] for r in rows]))} events, {np.mean([r['seconds'] for r in rows]):.1f} s per map"
+              + (f"\n    wrong: {listed}" if listed else ""))
     print(f"all: {total}/{len(results)} exact")
-    if args.records:
-        Path(args.records).write_text(json.dumps([r[9] for r in results], indent=1))
 
 
 if __name__ == "__main__":

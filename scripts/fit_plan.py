@@ -9,11 +9,13 @@ time (``benchmarks/outside_suite.py``).  The planning grid
 scales 0.75-2) varies each on its own.  This runs the grid's default-pipeline maps on
 Dask into ``--planning-store`` (resumable), reads the default pipeline's reporting
 maps from ``--store`` (a full ``swarmtopo bench accuracy`` run), fits the model on both
-(``plan.fit_plan``) and writes it (default: the shipped ``src/swarmtopo/data/plan.json``).
+(``plan.fit_plan``) and writes it (default: the shipped ``src/swarmtopo/data/plan.json``;
+``tests/test_plan.py``'s check of the shipped model's map count and ranges then needs
+the grid's figures).
 
-Printed: each candidate form's 10-fold cross-validated log loss and Brier score on all
-the maps (the previous form -- no swarm-size term -- fitted on the reporting maps only
-and on both, and the shipped form), then per budget of the grid the maps right beside
+Printed: the log loss and Brier score of the previous form (no swarm-size term) fitted
+on the reporting maps, scored on the grid; the 10-fold cross-validated scores of the
+previous form and of the form with ln N, each fitted on all the maps; then per budget of the grid the maps right beside
 what the fitted model expects.
 
     python scripts/fit_plan.py --store full.duckdb [--planning-store planning.duckdb] [--per-cell 3] [--workers 2]
@@ -86,33 +88,25 @@ def main() -> None:
           f"{sum(r['right'] for r in reported)} right")
 
     both = reported + planned
-    candidates = {
-        "previous form (no ln N), reporting maps only": (reported, lambda rs: fit_plan(rs, "cv", swarm_size=False)),
-        "previous form (no ln N), both": (both, lambda rs: fit_plan(rs, "cv", swarm_size=False)),
-        "with ln N, both (shipped)": (both, lambda rs: fit_plan(rs, "cv")),
-    }
-    for name, (train, fit) in candidates.items():
-        if train is both:
-            loss, brier = _cross_validated(both, fit, np.random.default_rng(0))
-            how = f"{FOLDS}-fold cross-validated"
-        else:  # fitted on the reporting maps, scored on the grid it never saw
-            loss, brier = _scores(fit(train), planned)
-            how = "on the planning grid"
-        print(f"{name}: log loss {loss:.4f}, Brier {brier:.4f} ({how})")
+    previous = fit_plan(reported, "previous", swarm_size=False)  # what bench accuracy fits
+    loss, brier = _scores(previous, planned)
+    print(f"previous form (no ln N), reporting maps only: log loss {loss:.4f}, Brier {brier:.4f} "
+          "(on the planning grid, which it never saw)")
+    for name, swarm_size in (("previous form (no ln N), both", False), ("with ln N, both", True)):
+        loss, brier = _cross_validated(both, lambda rs: fit_plan(rs, "cv", swarm_size=swarm_size),
+                                       np.random.default_rng(0))
+        print(f"{name}: log loss {loss:.4f}, Brier {brier:.4f} ({FOLDS}-fold cross-validated)")
 
     model = fit_plan(both, source=command)
-    previous = fit_plan(reported, "previous", swarm_size=False)
     print(f"fitted: c0 {model.intercept:.3f}, c1 (ln N/A) {model.density_coef:.3f}, c2 (ln T) "
           f"{model.duration_coef:.3f}, c4 (ln N) {model.agents_coef:.3f}, c3 (H) {model.holes_coef:.3f}; "
           f"{model.maps} maps")
-    print("| budget | planning maps right | shipped model expects | previous model expected |")
+    print("| budget | planning maps right | fitted model expects | previous model expected |")
     print("|---|---|---|---|")
     for n, t in PLANNING_BUDGETS:
         rows = [r for r in planned if r["agents"] == n and r["duration"] == t]
-        expect = [m.accuracy(r["area"], n, t, r["true_betti1"]) for m in (model, previous) for r in rows]
-        half = len(rows)
-        print(f"| {n} x {t:g} s | {sum(r['right'] for r in rows)}/{len(rows)} | "
-              f"{np.mean(expect[:half]):.2f} | {np.mean(expect[half:]):.2f} |")
+        expected = [np.mean([m.accuracy(r["area"], n, t, r["true_betti1"]) for r in rows]) for m in (model, previous)]
+        print(f"| {n} x {t:g} s | {sum(r['right'] for r in rows)}/{len(rows)} | {expected[0]:.2f} | {expected[1]:.2f} |")
     write_json(model.to_json(), args.out)
     print(f"wrote {args.out}")
 

@@ -1,24 +1,24 @@
 """Planning a deployment from the accuracy benchmark: what accuracy a swarm will get.
 
-The model is fitted by ``scripts/fit_plan.py`` on the default pipeline's maps of the
-benchmark's reporting cases and of its planning grid (``experiments.accuracy``:
-100-800 agents x 15-120 s in 0.14-1 m^2), and shipped as ``swarmtopo/data/plan.json``:
-a logistic regression of "(beta_0, beta_1) exactly right" on ln(agent density N / A),
-ln(duration T), ln(swarm size N) and the number of holes H,
+A logistic regression of "(beta_0, beta_1) exactly right" on ln(agent density N / A),
+ln(duration T), the number of holes H and, from format /3, ln(swarm size N):
 
     P(right | A, N, T, H) = sigmoid(c0 + c1 ln(N / A) + c2 ln T + c4 ln N + c3 H)
 
-(A in mm^2 inside the outer walls, N agents, T seconds).  The swarm size has a term of
-its own because a map's windows hold about N x 10 events whatever the arena: a small
-swarm in a small arena is as dense as a large one and maps worse.  The reporting
-cases alone cannot tell N from T (their budgets raise both together); the planning
-grid varies each on its own.  A team that does not know H gets the average over the
-benchmark's mix of hole counts (``PlanModel.holes_mix``).  The inverse questions
-solve the same equation for N or T.  The fit spans a range of densities, durations,
-swarm sizes and hole counts (``density_range``, ``duration_range``, ``agents_range``,
-``len(holes_mix) - 1``); answers outside it are extrapolations and say so.  Format /1
-files (no hole term) are read with c3 = 0, files before /3 with c4 = 0; files without
-``agents_range`` check no swarm size.
+(A in mm^2 inside the outer walls, N agents, T seconds).  The shipped
+``swarmtopo/data/plan.json`` is the format /2 model (c4 = 0) that ``swarmtopo bench
+accuracy`` fits on its reporting maps.  Those budgets raise N and T together (200 x
+30 s, 300 x 40 s, 400 x 60 s), so they cannot tell what more agents buy from what more
+time buys, and outside them the /2 model is optimistic (``benchmarks/outside_suite.py``).
+``scripts/fit_plan.py`` fits the /3 form on the reporting maps plus the benchmark's
+planning grid (``experiments.accuracy.PLANNING_CELLS``), which varies N, T and A each
+on its own; it has not replaced the shipped model yet.  A team that does not know H
+gets the average over the benchmark's mix of hole counts (``PlanModel.holes_mix``).
+The inverse questions solve the same equation for N or T.  The fit spans a range of
+densities, durations, swarm sizes and hole counts (``density_range``,
+``duration_range``, ``agents_range``, ``len(holes_mix) - 1``); answers outside it are
+extrapolations and say so.  Format /1 files (no hole term) are read with c3 = 0, files
+before /3 with c4 = 0; files without ``agents_range`` check no swarm size.
 """
 
 from __future__ import annotations
