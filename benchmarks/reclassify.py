@@ -39,9 +39,9 @@ COLUMNS = ("key", "config", "replicate", "diagrams", "error", "est_betti0", "con
 
 
 def default_rows(store: str) -> list[dict]:
-    """The store's rows of the default pipeline (its ``classifier`` is "default", reading the
-    whole log folder), sorted by key."""
-    return [row for row in read_jobs(store, columns=COLUMNS)
+    """The store's reporting rows of the default pipeline (its ``classifier`` is "default",
+    reading the whole log folder; not the planning grid's), sorted by key."""
+    return [row for row in read_jobs(store, columns=COLUMNS, sweep="accuracy-reporting-default")
             if row["config"]["map"].get("classifier") == PIPELINES["default"]["classifier"]
             and map_input(row["config"]["map"]) == "log"]
 

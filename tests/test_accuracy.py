@@ -138,10 +138,17 @@ def test_benchmark_runs_both_pipelines_on_dask_and_renders_its_table(tmp_path):
     assert len(summary["records"]) == len(cells)
     assert {r["area"] for r in summary["records"]} == {acc.case_area(j.config) for j in
                                                        acc.reporting_jobs(1, {"d": acc.PIPELINES["default"]}, cells)}
+    assert summary["planning"] == []
     text = acc.markdown(summary, "swarmtopo bench accuracy --test")
-    assert "swarmtopo bench accuracy --test" in text and cells[0].name in text
-    again = acc.run_benchmark(tmp_path / "acc.duckdb", per_cell=1, cells=cells, workers=1)
-    assert again["jobs_run"] == 0 and again["records"] == summary["records"]  # resumed: nothing reruns
+    assert "swarmtopo bench accuracy --test" in text and cells[0].name in text and "Planning grid" not in text
+    # with the planning grid (one of its cells): its maps under the default pipeline only,
+    # the reporting maps resumed, the grid's table rendered
+    planning_cells = (acc.PLANNING_CELLS[4],)  # 0 holes, 200 x 15 s
+    again = acc.run_benchmark(tmp_path / "acc.duckdb", per_cell=1, cells=cells, workers=1, planning_per_cell=1,
+                              planning_cells=planning_cells)
+    assert again["jobs_run"] == 1 and again["records"] == summary["records"]  # resumed: only the grid's map runs
+    assert [(r["agents"], r["duration"], r["true_betti1"]) for r in again["planning"]] == [(200, 15.0, 0)]
+    assert "| 200 x 15 s | " in acc.markdown(again, "swarmtopo bench accuracy --test")
     # benchmarks/reclassify.py reads the same default-pipeline maps back from the store's
     # columns: under the shipped classifier they give the bench's own records
     spec = importlib.util.spec_from_file_location("reclassify", ROOT / "benchmarks" / "reclassify.py")

@@ -154,16 +154,23 @@ def test_plan_cli_forward_and_inverse(tmp_path):
 
 
 def test_shipped_plan_was_fitted_on_the_full_benchmark():
-    from swarmtopo.experiments.accuracy import BUDGETS, CELLS, REPORTING_PER_CELL, SCALE_RANGE
+    from swarmtopo.experiments.accuracy import (BUDGETS, CELLS, PLANNING_BUDGETS, PLANNING_CELLS, PLANNING_PER_CELL,
+                                                PLANNING_SCALE_RANGE, REPORTING_PER_CELL, SCALE_RANGE)
     model = load_plan()
-    assert model.maps == len(CELLS) * REPORTING_PER_CELL
-    # its ranges are the suite's: 200-400 agents in (500 s)^2 rooms of scale 0.75-1.25
-    lo = min(n for n, _ in BUDGETS) / (2 * (500 * SCALE_RANGE[1]) ** 2)  # two rooms share their swarm
-    hi = max(n for n, _ in BUDGETS) / (500 * SCALE_RANGE[0]) ** 2
+    assert model.maps == len(CELLS) * REPORTING_PER_CELL + len(PLANNING_CELLS) * PLANNING_PER_CELL
+    # its ranges are the suite's and the planning grid's: 100-800 agents in (500 s)^2 rooms of
+    # scale 0.75-2 (two rooms of the suite share their swarm), 15-120 s
+    budgets = BUDGETS + PLANNING_BUDGETS
+    lo = min(n for n, _ in budgets) / (500 * PLANNING_SCALE_RANGE[1]) ** 2
+    hi = max(n for n, _ in budgets) / (500 * min(SCALE_RANGE[0], PLANNING_SCALE_RANGE[0])) ** 2
     assert lo * 0.99 <= model.density_range[0] and model.density_range[1] <= hi * 1.01
-    assert model.duration_range == (min(t for _, t in BUDGETS), max(t for _, t in BUDGETS))
-    assert model.agents_range == (min(n for n, _ in BUDGETS), max(n for n, _ in BUDGETS))
+    assert model.duration_range == (min(t for _, t in budgets), max(t for _, t in budgets))
+    assert model.agents_range == (min(n for n, _ in budgets), max(n for n, _ in budgets))
     assert len(model.holes_mix) == 4 and model.holes_coef < 0  # 0-3 holes; more holes, harder
+    # the swarm-size term is fitted (the grid tells it from duration), and it counts:
+    # at the same density and duration a larger swarm in a larger arena maps better
+    assert model.agents_coef > 0
+    assert model.accuracy(1e6, 800, 30, 2) > model.accuracy(0.25e6, 200, 30, 2)
 
 
 def test_swarms_too_small_to_map_are_refused_and_sizes_outside_the_benchmark_are_extrapolations(tmp_path):

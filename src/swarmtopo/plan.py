@@ -6,13 +6,12 @@ ln(duration T), the number of holes H and, from format /3, ln(swarm size N):
     P(right | A, N, T, H) = sigmoid(c0 + c1 ln(N / A) + c2 ln T + c4 ln N + c3 H)
 
 (A in mm^2 inside the outer walls, N agents, T seconds).  The shipped
-``swarmtopo/data/plan.json`` is the format /2 model (c4 = 0) that ``swarmtopo bench
-accuracy`` fits on its reporting maps.  Those budgets raise N and T together (200 x
-30 s, 300 x 40 s, 400 x 60 s), so they cannot tell what more agents buy from what more
-time buys, and outside them the /2 model is optimistic (``benchmarks/outside_suite.py``).
-``scripts/fit_plan.py`` fits the /3 form on the reporting maps plus the benchmark's
-planning grid (``experiments.accuracy.PLANNING_CELLS``), which varies N, T and A each
-on its own; it has not replaced the shipped model yet.  A team that does not know H
+``swarmtopo/data/plan.json`` is the /3 model the full ``swarmtopo bench accuracy`` fits
+on its reporting maps and its planning grid (``experiments.accuracy.PLANNING_CELLS``).
+The reporting budgets raise N and T together (200 x 30 s, 300 x 40 s, 400 x 60 s), so
+alone they cannot tell what more agents buy from what more time buys; the grid varies
+N, T and A each on its own.  ``--quick`` runs no grid and fits the /2 form (c4 = 0);
+``benchmarks/plan_forms.py`` compares the two forms.  A team that does not know H
 gets the average over the benchmark's mix of hole counts (``PlanModel.holes_mix``).
 The inverse questions solve the same equation for N or T.  The fit spans a range of
 densities, durations, swarm sizes and hole counts (``density_range``,

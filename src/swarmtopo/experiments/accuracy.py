@@ -199,7 +199,7 @@ def reporting_jobs(per_cell: int = REPORTING_PER_CELL, pipelines=None, cells=CEL
 
 def planning_jobs(per_cell: int = PLANNING_PER_CELL, cells=PLANNING_CELLS) -> list[Job]:
     """Jobs of the planning grid under the default pipeline (what ``plan`` is fitted on
-    besides the reporting maps: ``scripts/fit_plan.py``)."""
+    besides the reporting maps; the full ``swarmtopo bench accuracy`` runs them)."""
     return _jobs("planning", per_cell, {"default": PIPELINES["default"]}, cells)
 
 
@@ -351,15 +351,17 @@ def case_area(config: dict[str, Any]) -> float:
 
 
 def run_benchmark(store, *, quick: bool = False, scheduler: str | None = None, workers: int | None = None,
-                  progress=None, per_cell: int | None = None, cells=CELLS) -> dict[str, Any]:
-    """Run (or resume) the reporting cases of every pipeline; the summary document.
+                  progress=None, per_cell: int | None = None, cells=CELLS, planning_per_cell: int = 0,
+                  planning_cells=PLANNING_CELLS) -> dict[str, Any]:
+    """Run (or resume) the reporting cases of every pipeline, and ``planning_per_cell``
+    cases of each planning cell under the default pipeline; the summary document.
 
     Returns ``{"suite", "cases_per_cell", "seconds", "jobs_per_minute", "pipelines":
-    {name: {"table", "reliability"}}, "records"}`` with tables as from
-    :func:`accuracy_table` (``Rate`` objects as JSON) and the records of the default
-    pipeline (what ``plan`` is fitted on).  Each pipeline's maps are read by its
-    shipped classifier (:func:`outcomes`); ``paper-theta`` is the paper pipeline's
-    maps read by the paper's published Theta*.
+    {name: {"table", "reliability"}}, "records", "planning"}`` with tables as from
+    :func:`accuracy_table` (``Rate`` objects as JSON), the records of the default
+    pipeline's reporting maps and of the planning maps (what ``plan`` is fitted on).
+    Each pipeline's maps are read by its shipped classifier (:func:`outcomes`);
+    ``paper-theta`` is the paper pipeline's maps read by the paper's published Theta*.
     """
     from ..classify import load_classifier
     from .store import job_rows
@@ -367,7 +369,8 @@ def run_benchmark(store, *, quick: bool = False, scheduler: str | None = None, w
 
     per_cell = per_cell or (QUICK_PER_CELL if quick else REPORTING_PER_CELL)
     jobs = reporting_jobs(per_cell, cells=cells)
-    summary = run_sweep(jobs, store, scheduler=scheduler, workers=workers, progress=progress)
+    planning = planning_jobs(planning_per_cell, planning_cells) if planning_per_cell else []
+    summary = run_sweep(jobs + planning, store, scheduler=scheduler, workers=workers, progress=progress)
     rows = job_rows(store, jobs)
     by_pipeline = {name: [r for r in rows if _pipeline_of(r["config"]) == name] for name in PIPELINES}
     results = {name: outcomes(subset, load_classifier(PIPELINES[name]["classifier"]))
@@ -382,6 +385,8 @@ def run_benchmark(store, *, quick: bool = False, scheduler: str | None = None, w
                              "mean_seconds": float(np.mean([r["seconds"] for r in recs])) if recs else None}
                       for name, recs in results.items()},
         "records": results["default"],
+        "planning": outcomes(job_rows(store, planning), load_classifier(PIPELINES["default"]["classifier"]),
+                             cells=planning_cells) if planning else [],
     }
 
 
@@ -420,6 +425,15 @@ def markdown(summary: dict[str, Any], command: str) -> str:
         lines += ["", f"Regression slice: {sum(r['right'] for r in in_slice)}/{len(in_slice)} exact (the first "
                       f"{SLICE_PER_CELL} reporting cases of every cell, default pipeline; tests/test_accuracy.py "
                       "reruns them and fails below the 1 % binomial quantile of this rate, Laplace-smoothed)."]
+    if summary.get("planning"):
+        lines += ["", f"Planning grid ({len(summary['planning'])} maps, default pipeline, 0-3 holes, scales "
+                      f"{PLANNING_SCALE_RANGE[0]:g}-{PLANNING_SCALE_RANGE[1]:g}; with the reporting maps, what "
+                      "plan.json is fitted on), exact (beta_0, beta_1) per budget:", "",
+                  "| budget | maps right [Wilson 95 %] |", "|---|---|"]
+        for n, t in PLANNING_BUDGETS:
+            rows = [r for r in summary["planning"] if (r["agents"], r["duration"]) == (n, t)]
+            if rows:
+                lines.append(f"| {n} x {t:g} s | {rate_text(Rate(sum(r['right'] for r in rows), len(rows)).to_json())} |")
     for n_dim in ("1", "0"):
         rel = summary["pipelines"]["default"]["reliability"][n_dim]
         if not rel["maps"]:

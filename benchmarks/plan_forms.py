@@ -1,0 +1,95 @@
+"""Which form of ``swarmtopo plan``'s model to fit: with or without a swarm-size term.
+
+The reporting cases' budgets raise swarm size and duration together (200 x 30 s,
+300 x 40 s, 400 x 60 s), so on them alone a model cannot tell what more agents buy
+from what more time buys; fitted there, the /2 model (no ln N) put nearly all of it on
+time and promised 100 % to 100 agents x 120 s, which maps right about half the time
+(``benchmarks/outside_suite.py``).  The planning grid
+(``experiments.accuracy.PLANNING_CELLS``: 0-3 holes x 100-800 agents x 15-120 s,
+scales 0.75-2) varies each on its own; the full ``swarmtopo bench accuracy`` maps it
+and fits plan.json on both with the ln N term.  This reads the default pipeline's
+reporting and planning maps from that run's store and prints the evidence for the form:
+the log loss and Brier score of the /2 form fitted on the reporting maps alone, scored
+on the grid; the 10-fold cross-validated scores of the /2 and /3 forms fitted on all
+the maps; then per budget of the grid the maps right beside what each model expects.
+
+    python benchmarks/plan_forms.py --store full.duckdb
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+import numpy as np
+
+from swarmtopo.classify import load_classifier
+from swarmtopo.experiments.accuracy import (PIPELINES, PLANNING_BUDGETS, PLANNING_CELLS, PLANNING_PER_CELL,
+                                            REPORTING_PER_CELL, outcomes, planning_jobs, reporting_jobs)
+from swarmtopo.experiments.store import job_rows
+from swarmtopo.plan import fit_plan
+
+FOLDS = 10
+
+
+def _scores(model, records) -> tuple[float, float]:
+    """(mean log loss, Brier score) of a plan model's P(right) on records."""
+    p = np.clip([model.accuracy(r["area"], r["agents"], r["duration"], r["true_betti1"]) for r in records],
+                1e-6, 1 - 1e-6)
+    y = np.array([r["right"] for r in records], dtype=float)
+    return float(-np.mean(y * np.log(p) + (1 - y) * np.log(1 - p))), float(np.mean((p - y) ** 2))
+
+
+def _cross_validated(records, fit, rng) -> tuple[float, float]:
+    """Each record scored by a model fitted without its fold (``FOLDS`` random folds)."""
+    fold = rng.permutation(len(records)) % FOLDS
+    losses, briers = [], []
+    for k in range(FOLDS):
+        train = [r for r, f in zip(records, fold) if f != k]
+        test = [r for r, f in zip(records, fold) if f == k]
+        loss, brier = _scores(fit(train), test)
+        losses.append(loss * len(test))
+        briers.append(brier * len(test))
+    return sum(losses) / len(records), sum(briers) / len(records)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--store", required=True, help="store of a full swarmtopo bench accuracy run")
+    args = parser.parse_args()
+
+    classifier = load_classifier(PIPELINES["default"]["classifier"])
+    reporting = reporting_jobs(REPORTING_PER_CELL, {"default": PIPELINES["default"]})
+    planning = planning_jobs(PLANNING_PER_CELL)
+    reported = outcomes(job_rows(args.store, reporting), classifier)
+    planned = outcomes(job_rows(args.store, planning), classifier, cells=PLANNING_CELLS)
+    if (len(reported), len(planned)) != (len(reporting), len(planning)):
+        sys.exit(f"{args.store}: {len(reported)} of {len(reporting)} reporting and {len(planned)} of "
+                 f"{len(planning)} planning maps (run the full swarmtopo bench accuracy --store on it first)")
+    print(f"planning grid: {len(planned)} maps, {sum(r['right'] for r in planned)} right; reporting maps: "
+          f"{len(reported)}, {sum(r['right'] for r in reported)} right")
+
+    both = reported + planned
+    previous = fit_plan(reported, "/2, reporting", swarm_size=False)
+    loss, brier = _scores(previous, planned)
+    print(f"/2 form (no ln N), reporting maps only: log loss {loss:.4f}, Brier {brier:.4f} "
+          "(on the planning grid, which it never saw)")
+    for name, swarm_size in (("/2 form (no ln N), all maps", False), ("/3 form (ln N), all maps", True)):
+        loss, brier = _cross_validated(both, lambda rs: fit_plan(rs, "cv", swarm_size=swarm_size),
+                                       np.random.default_rng(0))
+        print(f"{name}: log loss {loss:.4f}, Brier {brier:.4f} ({FOLDS}-fold cross-validated)")
+
+    model = fit_plan(both, "/3, all")
+    print(f"/3 on all maps (what bench accuracy ships): c0 {model.intercept:.3f}, c1 (ln N/A) {model.density_coef:.3f}, "
+          f"c2 (ln T) {model.duration_coef:.3f}, c4 (ln N) {model.agents_coef:.3f}, c3 (H) {model.holes_coef:.3f}; "
+          f"{model.maps} maps")
+    print("| budget | planning maps right | /3 on all maps expects | /2 on reporting maps expects |")
+    print("|---|---|---|---|")
+    for n, t in PLANNING_BUDGETS:
+        rows = [r for r in planned if r["agents"] == n and r["duration"] == t]
+        expected = [np.mean([m.accuracy(r["area"], n, t, r["true_betti1"]) for r in rows]) for m in (model, previous)]
+        print(f"| {n} x {t:g} s | {sum(r['right'] for r in rows)}/{len(rows)} | {expected[0]:.2f} | {expected[1]:.2f} |")
+
+
+if __name__ == "__main__":
+    main()
