@@ -1,4 +1,4 @@
-"""Which form of ``swarmtopo plan``'s model to fit: with or without a swarm-size term.
+"""Which form of ``swarmtopo plan``'s model to fit: with or without swarm-size terms.
 
 The reporting cases' budgets raise swarm size and duration together (200 x 30 s,
 300 x 40 s, 400 x 60 s), so on them alone a model cannot tell what more agents buy
@@ -7,11 +7,13 @@ time and promised 100 % to 100 agents x 120 s, which maps right about half the t
 (``benchmarks/outside_suite.py``).  The planning grid
 (``experiments.accuracy.PLANNING_CELLS``: 0-3 holes x 100-800 agents x 15-120 s,
 scales 0.75-2) varies each on its own; the full ``swarmtopo bench accuracy`` maps it
-and fits plan.json on both with the ln N term.  This reads the default pipeline's
-reporting and planning maps from that run's store and prints the evidence for the form:
-the log loss and Brier score of the /2 form fitted on the reporting maps alone, scored
-on the grid; the 10-fold cross-validated scores of the /2 and /3 forms fitted on all
-the maps; then per budget of the grid the maps right beside what each model expects.
+and fits plan.json on both with the ln N and ln N ln T terms (the /4 form).  This reads
+the default pipeline's reporting and planning maps from that run's store and prints
+the evidence for the form: the log loss and Brier score of the /2 form fitted on the
+reporting maps alone, scored on the grid; the 10-fold cross-validated scores of the
+/2 (no swarm-size term), /3 (ln N) and /4 (ln N, ln N ln T) forms fitted on all the
+maps; then per budget of the grid the maps right beside what the /4 model on all maps
+and the /2 model on the reporting maps expect.
 
     python benchmarks/plan_forms.py --store full.duckdb
 """
@@ -74,16 +76,19 @@ def main() -> None:
     loss, brier = _scores(previous, planned)
     print(f"/2 form (no ln N), reporting maps only: log loss {loss:.4f}, Brier {brier:.4f} "
           "(on the planning grid, which it never saw)")
-    for name, swarm_size in (("/2 form (no ln N), all maps", False), ("/3 form (ln N), all maps", True)):
-        loss, brier = _cross_validated(both, lambda rs: fit_plan(rs, "cv", swarm_size=swarm_size),
+    for name, swarm_size, interaction in (("/2 form (no ln N), all maps", False, False),
+                                          ("/3 form (ln N), all maps", True, False),
+                                          ("/4 form (ln N, ln N ln T), all maps", True, True)):
+        loss, brier = _cross_validated(both, lambda rs: fit_plan(rs, "cv", swarm_size=swarm_size,
+                                                                 interaction=interaction),
                                        np.random.default_rng(0))
         print(f"{name}: log loss {loss:.4f}, Brier {brier:.4f} ({FOLDS}-fold cross-validated)")
 
-    model = fit_plan(both, "/3, all")
-    print(f"/3 on all maps (what bench accuracy ships): c0 {model.intercept:.3f}, c1 (ln N/A) {model.density_coef:.3f}, "
-          f"c2 (ln T) {model.duration_coef:.3f}, c4 (ln N) {model.agents_coef:.3f}, c3 (H) {model.holes_coef:.3f}; "
-          f"{model.maps} maps")
-    print("| budget | planning maps right | /3 on all maps expects | /2 on reporting maps expects |")
+    model = fit_plan(both, "/4, all")
+    print(f"/4 on all maps (what bench accuracy ships): c0 {model.intercept:.3f}, c1 (ln N/A) {model.density_coef:.3f}, "
+          f"c2 (ln T) {model.duration_coef:.3f}, c4 (ln N) {model.agents_coef:.3f}, c5 (ln N ln T) "
+          f"{model.agents_duration_coef:.3f}, c3 (H) {model.holes_coef:.3f}; {model.maps} maps")
+    print("| budget | planning maps right | /4 on all maps expects | /2 on reporting maps expects |")
     print("|---|---|---|---|")
     for n, t in PLANNING_BUDGETS:
         rows = [r for r in planned if r["agents"] == n and r["duration"] == t]

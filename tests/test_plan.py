@@ -37,7 +37,9 @@ def test_fit_recovers_the_law_it_was_drawn_from():
     model = fit_plan(synthetic_records(4000, rng), source="test")
     # slope standard errors at n = 4000 are about 0.1; 0.3 is three of them
     assert model.density_coef == pytest.approx(1.5, abs=0.3)
-    assert model.duration_coef == pytest.approx(2.0, abs=0.3)
+    # the law has no ln N ln T term: the fitted one is small, and time's slope at N = 300 is the law's
+    assert model.agents_duration_coef == pytest.approx(0.0, abs=0.6)
+    assert model.duration_coef + model.agents_duration_coef * np.log(300) == pytest.approx(2.0, abs=0.3)
     assert model.holes_coef == pytest.approx(-0.8, abs=0.3)
     assert model.holes_mix == pytest.approx((0.25,) * 4, abs=0.03)  # H uniform in 0-3
     z = -2.0 + 1.5 * np.log(300 / 1e6 * 1e4) + 2.0 * np.log(40 / 30)
@@ -45,33 +47,40 @@ def test_fit_recovers_the_law_it_was_drawn_from():
     assert model.accuracy(1e6, 300, 40) == pytest.approx(np.mean([sigmoid(z - 0.8 * h) for h in range(4)]), abs=0.04)
 
 
-def test_fit_tells_swarm_size_from_density_when_they_vary_apart():
-    """Drawn from a law with a ln N term of its own (c4 = 1.0) besides density and time:
-    the fit recovers it, and without the term (the /2 form) it cannot."""
+def test_fit_tells_swarm_size_from_density_and_time_when_they_vary_apart():
+    """Drawn from a law with a ln N term of its own and a ln N ln T term (time buys more
+    with more agents) besides density and time: the fit recovers the law's answers and
+    its interaction, and the /2 form (no swarm-size terms) leaves both out."""
     rng = np.random.default_rng(3)
+
+    def law(area, agents, duration, holes):
+        n, t = np.log(agents / 300), np.log(duration / 30)
+        return 0.5 + 0.8 * np.log(agents / area * 1e4) + 0.6 * t + 1.0 * n + 0.5 * n * t - 0.8 * holes
+
     records = []
-    for _ in range(4000):
-        area = rng.uniform(0.1e6, 1.0e6)
-        agents = int(rng.integers(100, 800))
-        duration = rng.uniform(15, 120)
+    for _ in range(6000):
+        area, agents, duration = rng.uniform(0.1e6, 1.0e6), int(rng.integers(100, 800)), rng.uniform(15, 120)
         holes = int(rng.integers(0, 4))
-        z = 0.5 + 0.8 * np.log(agents / area * 1e4) + 0.6 * np.log(duration / 30) + 1.0 * np.log(agents / 300) - 0.8 * holes
         records.append({"area": area, "agents": agents, "duration": duration, "true_betti1": holes,
-                        "right": bool(rng.random() < sigmoid(z))})
+                        "right": bool(rng.random() < sigmoid(law(area, agents, duration, holes)))})
     model = fit_plan(records, source="test")
-    assert model.agents_coef == pytest.approx(1.0, abs=0.3)
+    assert model.agents_duration_coef == pytest.approx(0.5, abs=0.25)
     assert model.density_coef == pytest.approx(0.8, abs=0.3)
-    assert model.duration_coef == pytest.approx(0.6, abs=0.3)
-    # a small swarm as dense as a big one: the law says it maps worse, and so does the model
-    z_small = 0.5 + 0.8 * np.log(100 / 0.1e6 * 1e4) + 0.6 * np.log(40 / 30) + 1.0 * np.log(100 / 300)
-    assert model.accuracy(0.1e6, 100, 40, holes=0) == pytest.approx(sigmoid(z_small), abs=0.05)
-    assert fit_plan(records, source="test", swarm_size=False).agents_coef == 0.0
-    # the inverse answer for N accounts for both terms
+    for case in ((0.1e6, 100, 40, 0), (0.1e6, 100, 120, 2), (1e6, 800, 15, 1), (0.5e6, 300, 30, 3), (0.3e6, 700, 100, 0)):
+        # a small swarm as dense as a big one maps worse, and time helps it less: the model says so too
+        assert model.accuracy(*case) == pytest.approx(sigmoid(law(*case)), abs=0.05), case
+    flat = fit_plan(records, source="test", swarm_size=False)
+    assert flat.agents_coef == 0.0 and flat.agents_duration_coef == 0.0
+    # the inverse answers account for every term
     n = model.agents_for(0.5e6, 40, 0.9, holes=1)
     assert model.accuracy(0.5e6, n, 40, holes=1) == pytest.approx(0.9)
-    closed = np.exp((np.log(0.9 / 0.1) - model.intercept - model.duration_coef * np.log(40) - model.holes_coef
-                     + model.density_coef * np.log(0.5e6)) / (model.density_coef + model.agents_coef))
+    log_t = np.log(40)
+    closed = np.exp((np.log(0.9 / 0.1) - model.intercept - model.duration_coef * log_t - model.holes_coef
+                     + model.density_coef * np.log(0.5e6))
+                    / (model.density_coef + model.agents_coef + model.agents_duration_coef * log_t))
     assert n == pytest.approx(closed, rel=1e-6)
+    t = model.duration_for(0.5e6, 300, 0.9, holes=1)
+    assert model.accuracy(0.5e6, 300, t, holes=1) == pytest.approx(0.9)
 
 
 def test_unknown_holes_average_over_the_mix_and_more_holes_need_more_data():
@@ -104,10 +113,21 @@ def test_inverse_answers_invert_the_forward_one():
 def test_format_2_files_read_without_a_swarm_size_term(tmp_path):
     model = PlanModel(-3.0, 1.2, 1.8, (1e-4, 1e-3), (30, 60), 100, "test", -0.5, (0.25,) * 4, (200.0, 400.0))
     old = {**model.to_json(), "format": "swarmtopo-plan/2"}
-    del old["agents_coef"]
+    del old["agents_coef"], old["agents_duration_coef"]
     path = tmp_path / "old.json"
     path.write_text(json.dumps(old))
     assert load_plan(path) == model and load_plan(path).agents_coef == 0.0
+
+
+def test_format_3_files_read_without_an_interaction_term(tmp_path):
+    model = PlanModel(-3.0, 1.2, 1.8, (1e-4, 1e-3), (30, 60), 100, "test", -0.5, (0.25,) * 4, (200.0, 400.0), 0.7)
+    old = {**model.to_json(), "format": "swarmtopo-plan/3"}
+    del old["agents_duration_coef"]
+    path = tmp_path / "old.json"
+    path.write_text(json.dumps(old))
+    assert load_plan(path) == model and load_plan(path).agents_duration_coef == 0.0
+    assert load_plan(path).accuracy(250_000, 200, 30, 1) == pytest.approx(
+        sigmoid(-3.0 + 1.2 * np.log(200 / 250_000) + 1.8 * np.log(30) + 0.7 * np.log(200) - 0.5))
 
 
 def test_format_1_files_read_without_a_hole_term_and_bad_mixes_are_refused(tmp_path):
@@ -167,9 +187,14 @@ def test_shipped_plan_was_fitted_on_the_full_benchmark():
     assert model.duration_range == (min(t for _, t in budgets), max(t for _, t in budgets))
     assert model.agents_range == (min(n for n, _ in budgets), max(n for n, _ in budgets))
     assert len(model.holes_mix) == 4 and model.holes_coef < 0  # 0-3 holes; more holes, harder
-    # the swarm-size term is fitted (the grid tells it from duration), and it counts:
-    # at the same density and duration a larger swarm in a larger arena maps better
-    assert model.agents_coef > 0
+    # the swarm-size terms are fitted (the grid tells them from duration), and they count
+    # across the fitted range: at the same density and duration a larger swarm in a larger
+    # arena maps better, and time helps a small swarm less than a large one
+    assert model.agents_duration_coef > 0
+    for log_t in np.log(model.duration_range):
+        assert model.agents_coef + model.agents_duration_coef * log_t > 0
+    for log_n in np.log(model.agents_range):
+        assert model.duration_coef + model.agents_duration_coef * log_n > 0
     assert model.accuracy(1e6, 800, 30, 2) > model.accuracy(0.25e6, 200, 30, 2)
 
 
@@ -187,8 +212,8 @@ def test_swarms_too_small_to_map_are_refused_and_sizes_outside_the_benchmark_are
     res = runner.invoke(app, small_room + ["--agents", "5", "--duration", "30"])
     assert res.exit_code == 0 and "outside the benchmark's range" in res.output
     assert model.density_range[0] <= 5 / 20000 <= model.density_range[1]
-    res = runner.invoke(app, small_room + ["--duration", "80", "--target", "0.2"])
-    assert res.exit_code == 0 and "needed: 3 agents" in res.output and model.agents_for(20000, 80, 0.2) < 3
+    res = runner.invoke(app, small_room + ["--duration", "80", "--target", "0.05"])
+    assert res.exit_code == 0 and "needed: 3 agents" in res.output and model.agents_for(20000, 80, 0.05) < 3
 
 
 @pytest.mark.parametrize("key, value", [("duration_range", [60]), ("density_range", [2e-3, 5e-4]),

@@ -579,7 +579,7 @@ def bench_accuracy(
     default pipeline and the paper's, from log folders stripped of ground truth, on
     Dask; prints the table with Wilson 95 % intervals and the confidence's reliability.
     The full run also maps the planning grid (agents and duration varied apart) and fits
-    plan.json on both; --quick fits it on its reporting maps without the swarm-size term.
+    plan.json on both; --quick fits it on its reporting maps without the swarm-size terms.
     """
     import shlex
     import time
@@ -607,7 +607,7 @@ def bench_accuracy(
     (out_dir / "accuracy.md").write_text(text, encoding="utf-8")
     written.append(out_dir / "accuracy.md")
     try:
-        # ln N is only told apart from ln T by the planning grid (the suite's budgets raise both together)
+        # ln N and ln N ln T are only told apart from ln T by the planning grid (the suite's budgets raise N and T together)
         written.append(write_json(fit_plan(summary["records"] + summary["planning"], source=command,
                                            swarm_size=bool(summary["planning"])).to_json(), out_dir / "plan.json"))
     except SwarmtopoError as exc:

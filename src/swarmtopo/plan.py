@@ -1,23 +1,25 @@
 """Planning a deployment from the accuracy benchmark: what accuracy a swarm will get.
 
 A logistic regression of "(beta_0, beta_1) exactly right" on ln(agent density N / A),
-ln(duration T), the number of holes H and, from format /3, ln(swarm size N):
+ln(duration T), the number of holes H and, from format /3, ln(swarm size N) and, from
+format /4, ln N ln T (time buys more with more agents):
 
-    P(right | A, N, T, H) = sigmoid(c0 + c1 ln(N / A) + c2 ln T + c4 ln N + c3 H)
+    P(right | A, N, T, H) = sigmoid(c0 + c1 ln(N / A) + c2 ln T + c4 ln N + c5 ln N ln T + c3 H)
 
 (A in mm^2 inside the outer walls, N agents, T seconds).  The shipped
-``swarmtopo/data/plan.json`` is the /3 model the full ``swarmtopo bench accuracy`` fits
+``swarmtopo/data/plan.json`` is the /4 model the full ``swarmtopo bench accuracy`` fits
 on its reporting maps and its planning grid (``experiments.accuracy.PLANNING_CELLS``).
 The reporting budgets raise N and T together (200 x 30 s, 300 x 40 s, 400 x 60 s), so
 alone they cannot tell what more agents buy from what more time buys; the grid varies
-N, T and A each on its own.  ``--quick`` runs no grid and fits the /2 form (c4 = 0);
-``benchmarks/plan_forms.py`` compares the two forms.  A team that does not know H
+N, T and A each on its own.  ``--quick`` runs no grid and fits the /2 form (c4 = c5 = 0);
+``benchmarks/plan_forms.py`` compares the forms.  A team that does not know H
 gets the average over the benchmark's mix of hole counts (``PlanModel.holes_mix``).
 The inverse questions solve the same equation for N or T.  The fit spans a range of
 densities, durations, swarm sizes and hole counts (``density_range``,
 ``duration_range``, ``agents_range``, ``len(holes_mix) - 1``); answers outside it are
 extrapolations and say so.  Format /1 files (no hole term) are read with c3 = 0, files
-before /3 with c4 = 0; files without ``agents_range`` check no swarm size.
+before /3 with c4 = 0, before /4 with c5 = 0; files without ``agents_range`` check no
+swarm size.
 """
 
 from __future__ import annotations
@@ -36,8 +38,8 @@ from sklearn.linear_model import LogisticRegression
 from ._validate import check_format, positive
 from .errors import InputError, SwarmtopoError
 
-PLAN_FORMAT = "swarmtopo-plan/3"
-READ_FORMATS = ("swarmtopo-plan/1", "swarmtopo-plan/2", PLAN_FORMAT)
+PLAN_FORMAT = "swarmtopo-plan/4"
+READ_FORMATS = ("swarmtopo-plan/1", "swarmtopo-plan/2", "swarmtopo-plan/3", PLAN_FORMAT)
 LOG_SPAN = 50.0
 """How far (in ln units) beyond the benchmark's range the inverse answers search."""
 
@@ -45,7 +47,7 @@ LOG_SPAN = 50.0
 @dataclass(frozen=True)
 class PlanModel:
     """P(right) = sigmoid(intercept + density_coef ln(N/A) + duration_coef ln T
-    + agents_coef ln N + holes_coef H)."""
+    + agents_coef ln N + agents_duration_coef ln N ln T + holes_coef H)."""
 
     intercept: float
     density_coef: float
@@ -58,6 +60,7 @@ class PlanModel:
     holes_mix: tuple[float, ...] = (1.0,)  # fraction of the benchmark's maps with 0, 1, 2, ... holes
     agents_range: tuple[float, float] | None = None  # swarm sizes the benchmark ran (None: not recorded)
     agents_coef: float = 0.0
+    agents_duration_coef: float = 0.0
 
     def accuracy(self, area: float, agents: float, duration: float, holes: int | None = None) -> float:
         """Expected exact-match accuracy of the default pipeline with ``holes`` holes
@@ -69,7 +72,8 @@ class PlanModel:
         """Agents N needed for ``target`` accuracy (inf if more agents do not help)."""
         _check_positive(area=area, duration=duration)
         log_a, log_t = np.log(area), np.log(duration)
-        log_n = self._solve(lambda x: self._accuracy(x, log_a, log_t, holes), self.density_coef + self.agents_coef,
+        log_n = self._solve(lambda x: self._accuracy(x, log_a, log_t, holes),
+                            self.density_coef + self.agents_coef + self.agents_duration_coef * log_t,
                             np.log(self.density_range) + log_a, target)
         return float(np.exp(log_n))
 
@@ -77,7 +81,8 @@ class PlanModel:
         """Seconds T needed for ``target`` accuracy (inf if more time does not help)."""
         _check_positive(area=area, agents=agents)
         log_n, log_a = np.log(agents), np.log(area)
-        log_t = self._solve(lambda x: self._accuracy(log_n, log_a, x, holes), self.duration_coef,
+        log_t = self._solve(lambda x: self._accuracy(log_n, log_a, x, holes),
+                            self.duration_coef + self.agents_duration_coef * log_n,
                             np.log(self.duration_range), target)
         return float(np.exp(log_t))
 
@@ -91,7 +96,7 @@ class PlanModel:
 
     def _accuracy(self, log_agents: float, log_area: float, log_duration: float, holes: int | None) -> float:
         base = (self.intercept + self.density_coef * (log_agents - log_area) + self.duration_coef * log_duration
-                + self.agents_coef * log_agents)
+                + self.agents_coef * log_agents + self.agents_duration_coef * log_agents * log_duration)
         if holes is not None:
             if holes < 0:
                 raise InputError("the number of holes must be >= 0", column="holes", value=holes)
@@ -114,7 +119,7 @@ class PlanModel:
                 "duration_coef": self.duration_coef, "holes_coef": self.holes_coef,
                 "holes_mix": list(self.holes_mix), "density_range": list(self.density_range),
                 "duration_range": list(self.duration_range), "maps": self.maps, "source": self.source,
-                "agents_coef": self.agents_coef,
+                "agents_coef": self.agents_coef, "agents_duration_coef": self.agents_duration_coef,
                 **({} if self.agents_range is None else {"agents_range": list(self.agents_range)})}
 
     @classmethod
@@ -126,7 +131,7 @@ class PlanModel:
                         int(obj["maps"]), str(obj["source"]), float(obj.get("holes_coef", 0.0)),
                         tuple(map(float, obj.get("holes_mix", (1.0,)))),
                         tuple(map(float, obj["agents_range"])) if "agents_range" in obj else None,
-                        float(obj.get("agents_coef", 0.0)))
+                        float(obj.get("agents_coef", 0.0)), float(obj.get("agents_duration_coef", 0.0)))
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"malformed plan model: {exc!r}", file=source) from None
         for name in ("density_range", "duration_range", "agents_range"):
@@ -140,10 +145,12 @@ class PlanModel:
         return model
 
 
-def fit_plan(records: Sequence[dict[str, Any]], source: str, *, swarm_size: bool = True) -> PlanModel:
+def fit_plan(records: Sequence[dict[str, Any]], source: str, *, swarm_size: bool = True,
+             interaction: bool = True) -> PlanModel:
     """The plan model of benchmark records (``area``, ``agents``, ``duration``,
     ``true_betti1``, ``right``), by a lightly regularised logistic regression;
-    ``swarm_size=False`` leaves out the ln N term (c4 = 0: the format /2 model)."""
+    ``swarm_size=False`` leaves out the ln N and ln N ln T terms (c4 = c5 = 0: the
+    format /2 model), ``interaction=False`` the ln N ln T term (c5 = 0: the /3 model)."""
     agents = np.array([r["agents"] for r in records], dtype=float)
     density = agents / np.array([r["area"] for r in records], dtype=float)
     duration = np.array([r["duration"] for r in records], dtype=float)
@@ -151,14 +158,16 @@ def fit_plan(records: Sequence[dict[str, Any]], source: str, *, swarm_size: bool
     right = np.array([r["right"] for r in records], dtype=bool)
     if len(np.unique(right)) < 2:
         raise SwarmtopoError("the plan needs both right and wrong maps to fit (every map had the same outcome)")
-    X = np.column_stack([np.log(density), np.log(duration), holes] + ([np.log(agents)] if swarm_size else []))
+    terms = ([np.log(agents)] if swarm_size else []) + ([np.log(agents) * np.log(duration)]
+                                                         if swarm_size and interaction else [])
+    X = np.column_stack([np.log(density), np.log(duration), holes] + terms)
     model = LogisticRegression(C=10.0).fit(X, right)
     mix = np.bincount(holes) / len(holes)
     coef = model.coef_[0]
     return PlanModel(float(model.intercept_[0]), float(coef[0]), float(coef[1]),
                      (float(density.min()), float(density.max())), (float(duration.min()), float(duration.max())),
                      int(len(right)), source, float(coef[2]), tuple(float(w) for w in mix),
-                     (float(agents.min()), float(agents.max())), float(coef[3]) if swarm_size else 0.0)
+                     (float(agents.min()), float(agents.max())), *(list(map(float, coef[3:])) + [0.0, 0.0])[:2])
 
 
 def load_plan(path: str | Path | None = None) -> PlanModel:
