@@ -12,8 +12,8 @@ the default pipeline's reporting and planning maps from that run's store and pri
 the evidence for the form: the log loss and Brier score of the /2 form fitted on the
 reporting maps alone, scored on the grid; the 10-fold cross-validated scores of the
 /2 (no swarm-size term), /3 (ln N) and /4 (ln N, ln N ln T) forms fitted on all the
-maps; then per budget of the grid the maps right beside what the /4 model on all maps
-and the /2 model on the reporting maps expect.
+maps; then per budget of the grid the maps right beside what the /4 and /3 models on
+all maps and the /2 model on the reporting maps expect.
 
     python benchmarks/plan_forms.py --store full.duckdb
 """
@@ -28,7 +28,7 @@ import numpy as np
 from swarmtopo.classify import load_classifier
 from swarmtopo.experiments.accuracy import (PIPELINES, PLANNING_BUDGETS, PLANNING_CELLS, PLANNING_PER_CELL,
                                             REPORTING_PER_CELL, outcomes, planning_jobs, reporting_jobs)
-from swarmtopo.experiments.store import job_rows
+from swarmtopo.experiments.store import job_rows_each
 from swarmtopo.plan import fit_plan
 
 FOLDS = 10
@@ -63,8 +63,9 @@ def main() -> None:
     classifier = load_classifier(PIPELINES["default"]["classifier"])
     reporting = reporting_jobs(REPORTING_PER_CELL, {"default": PIPELINES["default"]})
     planning = planning_jobs(PLANNING_PER_CELL)
-    reported = outcomes(job_rows(args.store, reporting), classifier)
-    planned = outcomes(job_rows(args.store, planning), classifier, cells=PLANNING_CELLS)
+    reporting_rows, planning_rows = job_rows_each(args.store, reporting, planning)
+    reported = outcomes(reporting_rows, classifier)
+    planned = outcomes(planning_rows, classifier, cells=PLANNING_CELLS)
     if (len(reported), len(planned)) != (len(reporting), len(planning)):
         sys.exit(f"{args.store}: {len(reported)} of {len(reporting)} reporting and {len(planned)} of "
                  f"{len(planning)} planning maps (run the full swarmtopo bench accuracy --store on it first)")
@@ -72,28 +73,27 @@ def main() -> None:
           f"{len(reported)}, {sum(r['right'] for r in reported)} right")
 
     both = reported + planned
-    previous = fit_plan(reported, "/2, reporting", swarm_size=False)
+    previous = fit_plan(reported, "/2, reporting", swarm_terms=0)
     loss, brier = _scores(previous, planned)
     print(f"/2 form (no ln N), reporting maps only: log loss {loss:.4f}, Brier {brier:.4f} "
           "(on the planning grid, which it never saw)")
-    for name, swarm_size, interaction in (("/2 form (no ln N), all maps", False, False),
-                                          ("/3 form (ln N), all maps", True, False),
-                                          ("/4 form (ln N, ln N ln T), all maps", True, True)):
-        loss, brier = _cross_validated(both, lambda rs: fit_plan(rs, "cv", swarm_size=swarm_size,
-                                                                 interaction=interaction),
+    for name, terms in (("/2 form (no ln N), all maps", 0), ("/3 form (ln N), all maps", 1),
+                        ("/4 form (ln N, ln N ln T), all maps", 2)):
+        loss, brier = _cross_validated(both, lambda rs: fit_plan(rs, "cv", swarm_terms=terms),
                                        np.random.default_rng(0))
         print(f"{name}: log loss {loss:.4f}, Brier {brier:.4f} ({FOLDS}-fold cross-validated)")
 
-    model = fit_plan(both, "/4, all")
+    model, form3 = fit_plan(both, "/4, all"), fit_plan(both, "/3, all", swarm_terms=1)
     print(f"/4 on all maps (what bench accuracy ships): c0 {model.intercept:.3f}, c1 (ln N/A) {model.density_coef:.3f}, "
           f"c2 (ln T) {model.duration_coef:.3f}, c4 (ln N) {model.agents_coef:.3f}, c5 (ln N ln T) "
           f"{model.agents_duration_coef:.3f}, c3 (H) {model.holes_coef:.3f}; {model.maps} maps")
-    print("| budget | planning maps right | /4 on all maps expects | /2 on reporting maps expects |")
-    print("|---|---|---|---|")
+    print("| budget | planning maps right | /4 on all maps expects | /3 on all maps | /2 on reporting maps |")
+    print("|---|---|---|---|---|")
     for n, t in PLANNING_BUDGETS:
         rows = [r for r in planned if r["agents"] == n and r["duration"] == t]
-        expected = [np.mean([m.accuracy(r["area"], n, t, r["true_betti1"]) for r in rows]) for m in (model, previous)]
-        print(f"| {n} x {t:g} s | {sum(r['right'] for r in rows)}/{len(rows)} | {expected[0]:.2f} | {expected[1]:.2f} |")
+        expected = " | ".join(f"{np.mean([m.accuracy(r['area'], n, t, r['true_betti1']) for r in rows]):.2f}"
+                              for m in (model, form3, previous))
+        print(f"| {n} x {t:g} s | {sum(r['right'] for r in rows)}/{len(rows)} | {expected} |")
 
 
 if __name__ == "__main__":

@@ -69,7 +69,7 @@ def test_fit_tells_swarm_size_from_density_and_time_when_they_vary_apart():
     for case in ((0.1e6, 100, 40, 0), (0.1e6, 100, 120, 2), (1e6, 800, 15, 1), (0.5e6, 300, 30, 3), (0.3e6, 700, 100, 0)):
         # a small swarm as dense as a big one maps worse, and time helps it less: the model says so too
         assert model.accuracy(*case) == pytest.approx(sigmoid(law(*case)), abs=0.05), case
-    flat = fit_plan(records, source="test", swarm_size=False)
+    flat = fit_plan(records, source="test", swarm_terms=0)
     assert flat.agents_coef == 0.0 and flat.agents_duration_coef == 0.0
     # the inverse answers account for every term
     n = model.agents_for(0.5e6, 40, 0.9, holes=1)

@@ -609,7 +609,7 @@ def bench_accuracy(
     try:
         # ln N and ln N ln T are only told apart from ln T by the planning grid (the suite's budgets raise N and T together)
         written.append(write_json(fit_plan(summary["records"] + summary["planning"], source=command,
-                                           swarm_size=bool(summary["planning"])).to_json(), out_dir / "plan.json"))
+                                           swarm_terms=2 if summary["planning"] else 0).to_json(), out_dir / "plan.json"))
     except SwarmtopoError as exc:
         _warn(f"no plan.json: {exc}", quiet)
     if not quiet:

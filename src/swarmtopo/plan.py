@@ -145,12 +145,11 @@ class PlanModel:
         return model
 
 
-def fit_plan(records: Sequence[dict[str, Any]], source: str, *, swarm_size: bool = True,
-             interaction: bool = True) -> PlanModel:
+def fit_plan(records: Sequence[dict[str, Any]], source: str, *, swarm_terms: int = 2) -> PlanModel:
     """The plan model of benchmark records (``area``, ``agents``, ``duration``,
     ``true_betti1``, ``right``), by a lightly regularised logistic regression;
-    ``swarm_size=False`` leaves out the ln N and ln N ln T terms (c4 = c5 = 0: the
-    format /2 model), ``interaction=False`` the ln N ln T term (c5 = 0: the /3 model)."""
+    ``swarm_terms`` of the swarm-size terms ln N, ln N ln T in that order: 2 (the /4
+    model), 1 (c5 = 0: the /3 model) or 0 (c4 = c5 = 0: the /2 model)."""
     agents = np.array([r["agents"] for r in records], dtype=float)
     density = agents / np.array([r["area"] for r in records], dtype=float)
     duration = np.array([r["duration"] for r in records], dtype=float)
@@ -158,16 +157,15 @@ def fit_plan(records: Sequence[dict[str, Any]], source: str, *, swarm_size: bool
     right = np.array([r["right"] for r in records], dtype=bool)
     if len(np.unique(right)) < 2:
         raise SwarmtopoError("the plan needs both right and wrong maps to fit (every map had the same outcome)")
-    terms = ([np.log(agents)] if swarm_size else []) + ([np.log(agents) * np.log(duration)]
-                                                         if swarm_size and interaction else [])
-    X = np.column_stack([np.log(density), np.log(duration), holes] + terms)
+    swarm = [np.log(agents), np.log(agents) * np.log(duration)][:swarm_terms]
+    X = np.column_stack([np.log(density), np.log(duration), holes] + swarm)
     model = LogisticRegression(C=10.0).fit(X, right)
     mix = np.bincount(holes) / len(holes)
-    coef = model.coef_[0]
+    coef = np.concatenate([model.coef_[0], np.zeros(2 - swarm_terms)])  # c4, c5 = 0 where left out
     return PlanModel(float(model.intercept_[0]), float(coef[0]), float(coef[1]),
                      (float(density.min()), float(density.max())), (float(duration.min()), float(duration.max())),
                      int(len(right)), source, float(coef[2]), tuple(float(w) for w in mix),
-                     (float(agents.min()), float(agents.max())), *(list(map(float, coef[3:])) + [0.0, 0.0])[:2])
+                     (float(agents.min()), float(agents.max())), float(coef[3]), float(coef[4]))
 
 
 def load_plan(path: str | Path | None = None) -> PlanModel:

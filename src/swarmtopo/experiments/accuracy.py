@@ -364,17 +364,17 @@ def run_benchmark(store, *, quick: bool = False, scheduler: str | None = None, w
     ``paper-theta`` is the paper pipeline's maps read by the paper's published Theta*.
     """
     from ..classify import load_classifier
-    from .store import job_rows
+    from .store import job_rows_each
     from .sweep import run_sweep
 
     per_cell = per_cell or (QUICK_PER_CELL if quick else REPORTING_PER_CELL)
     jobs = reporting_jobs(per_cell, cells=cells)
     planning = planning_jobs(planning_per_cell, planning_cells) if planning_per_cell else []
     summary = run_sweep(jobs + planning, store, scheduler=scheduler, workers=workers, progress=progress)
-    rows = job_rows(store, jobs)
+    rows, planning_rows = job_rows_each(store, jobs, planning)
     by_pipeline = {name: [r for r in rows if _pipeline_of(r["config"]) == name] for name in PIPELINES}
-    results = {name: outcomes(subset, load_classifier(PIPELINES[name]["classifier"]))
-               for name, subset in by_pipeline.items()}
+    classifiers = {name: load_classifier(PIPELINES[name]["classifier"]) for name in PIPELINES}
+    results = {name: outcomes(subset, classifiers[name]) for name, subset in by_pipeline.items()}
     results["paper-theta"] = outcomes(by_pipeline["paper"], load_classifier("paper"))
     return {
         "suite": SUITE, "cases_per_cell": per_cell, "maps": len(rows),
@@ -385,8 +385,7 @@ def run_benchmark(store, *, quick: bool = False, scheduler: str | None = None, w
                              "mean_seconds": float(np.mean([r["seconds"] for r in recs])) if recs else None}
                       for name, recs in results.items()},
         "records": results["default"],
-        "planning": outcomes(job_rows(store, planning), load_classifier(PIPELINES["default"]["classifier"]),
-                             cells=planning_cells) if planning else [],
+        "planning": outcomes(planning_rows, classifiers["default"], cells=planning_cells),
     }
 
 

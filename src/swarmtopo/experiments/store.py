@@ -179,8 +179,13 @@ def read_jobs(path, sweep: str | None = None, columns: Sequence[str] | None = No
 
 def job_rows(path, jobs) -> list[dict[str, Any]]:
     """The stored rows of these jobs (:func:`read_jobs`, every column), sorted by key."""
-    keys = {job.key for job in jobs}
-    return [row for row in read_jobs(path) if row["key"] in keys]
+    return job_rows_each(path, jobs)[0]
+
+
+def job_rows_each(path, *job_lists) -> list[list[dict[str, Any]]]:
+    """The stored rows of each list of jobs, from one read of the store, each sorted by key."""
+    rows = read_jobs(path)
+    return [[row for row in rows if row["key"] in keys] for keys in ({job.key for job in jobs} for jobs in job_lists)]
 
 
 def _tables(db) -> set[str]:
