@@ -16,7 +16,8 @@ Prints per regime: exact (beta_0, beta_1) with its Wilson 95 % interval, what th
 shipped plan model expects for the regime's cases (mean over them; regimes with the
 paper's motion and sensing only), the wrong maps as (true -> mapped, beta_1
 confidence), the mean beta_1 confidence of the right and of the wrong maps, events per
-log and seconds per map.
+log and seconds per map; then the reliability of the beta_1 confidence over all the
+regimes' maps (Brier score against a constant, and its bins).
 
     python benchmarks/outside_suite.py [--per-regime 12] [--first 0] [--regimes NAME ...] [--set FIELD=VALUE ...]
 
@@ -37,7 +38,7 @@ import numpy as np
 
 from swarmtopo.arena import HOLE_SHAPES, OUTER_SHAPES, random_arena
 from swarmtopo.errors import SwarmtopoError
-from swarmtopo.experiments.accuracy import ROOM_SIDE, Rate
+from swarmtopo.experiments.accuracy import ROOM_SIDE, Rate, reliability
 from swarmtopo.experiments.sweep import stripped_log
 from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.plan import load_plan
@@ -159,6 +160,14 @@ def main() -> None:
               f"{int(np.median([r['events'] for r in rows]))} events, {np.mean([r['seconds'] for r in rows]):.1f} s per map"
               + (f"\n    wrong: {listed}" if listed else ""))
     print(f"all: {total}/{len(results)} exact")
+    rel = reliability([{"confidence_betti1": r["confidence"], "betti1_right": r["mapped"][1] == r["truth"][1]}
+                       for r in results], 1)
+    if rel["maps"]:
+        print(f"beta_1 confidence over all regimes ({rel['maps']} maps): Brier {rel['brier']:.4f} against "
+              f"{rel['brier_constant']:.4f} for a constant equal to the rate")
+        for b in rel["bins"]:
+            print(f"  {b['low']:.2f}-{b['high']:.2f}: {b['maps']} maps, said {b['mean_confidence']:.3f}, "
+                  f"right {b['fraction_right']:.3f} [{b['wilson95'][0]:.2f}, {b['wilson95'][1]:.2f}]")
 
 
 if __name__ == "__main__":

@@ -9,7 +9,10 @@ or the lower median of the windows' counts) on its stored per-window diagrams, a
 writes
 
 * ``src/swarmtopo/data/classifier-default.json``: the classifier of the ``CHOSEN``
-  candidate and pooling, its confidence calibrated on the tuning maps (the ``gated``
+  candidate and pooling, its confidence calibrated on the tuning maps (cross-fitted)
+  and on the calibration grid (``experiments.accuracy.calibration_jobs``: the planning
+  grid's swarm sizes, durations and arenas with seeds of their own, mapped by the
+  default pipeline), so that it holds beyond the suite's budgets (the ``gated``
   classifier, ``scripts/fit_agreement_gate.py``, starts from its q_1 and tau_1);
 * ``src/swarmtopo/data/classifier-trace.json``: the same for ``CHOSEN_TRACE``, the
   chosen pipeline reading the tuning cases as contact traces (encounters only), which
@@ -24,9 +27,14 @@ one draw moves the count of a candidate by several maps.  The choice rests on
 run fits the chosen classifier and puts the rest on record.  The chosen pipeline's
 options are the defaults of ``MapConfig``; the script stops with an error if they differ.
 
+``--calibrate-only`` maps only the chosen candidate's tuning cases and the calibration
+grid, stops unless they give the shipped thresholds, and rewrites the default
+classifier's confidence alone.
+
 Usage::
 
     python scripts/tune_accuracy.py [--store tuning.duckdb] [--per-cell 20] [--workers N] [--scheduler ADDR]
+                                    [--calibrate-only]
 """
 
 from __future__ import annotations
@@ -38,7 +46,9 @@ from pathlib import Path
 import numpy as np
 
 from swarmtopo import __version__
-from swarmtopo.experiments.accuracy import CELLS, HELD_OUT_FAMILY, SUITE, TUNING_PER_CELL, cell_of, tuning_jobs, tuning_session
+from swarmtopo.classify import load_classifier
+from swarmtopo.experiments.accuracy import (CELLS, HELD_OUT_FAMILY, PLANNING_CELLS, SUITE, TUNING_PER_CELL, calibration_jobs,
+                                           cell_of, tuning_jobs, tuning_session)
 from swarmtopo.experiments.store import job_rows
 from swarmtopo.experiments.sweep import job_map_config, run_sweep
 from swarmtopo.experiments.tuning import (PIPELINE_FIELDS, Q_GRID, TAU_GRID, calibrated_classifier, cross_validated, exact,
@@ -88,29 +98,37 @@ def main() -> None:
     parser.add_argument("--per-cell", type=int, default=TUNING_PER_CELL)
     parser.add_argument("--workers", type=int, default=None)
     parser.add_argument("--scheduler", default=None)
+    parser.add_argument("--calibrate-only", action="store_true",
+                        help="map only the chosen pipeline's tuning cases and the calibration grid, check that they "
+                             "give the shipped thresholds and rewrite classifier-default.json's confidence "
+                             "(docs/tuning.md and the trace classifier are left as they are)")
     args = parser.parse_args()
 
     started = time.perf_counter()
+    candidates = {CHOSEN[0]: CANDIDATES[CHOSEN[0]]} if args.calibrate_only else CANDIDATES
     with tuning_session():
         pipelines = {name: {"metric": "hybrid", "classifier": "paper-form", **options}
-                     for name, options in CANDIDATES.items()}
+                     for name, options in candidates.items()}
         jobs = {name: tuning_jobs({name: p}, per_cell=args.per_cell) for name, p in pipelines.items()}
-        summary = run_sweep([j for js in jobs.values() for j in js], args.store, scheduler=args.scheduler,
-                            workers=args.workers,
+        grid = calibration_jobs()
+        every = [j for js in jobs.values() for j in js] + grid
+        summary = run_sweep(every, args.store, scheduler=args.scheduler, workers=args.workers,
                             progress=lambda done, total, failed: print(f"\r{done}/{total} jobs", end="", flush=True))
         print(f"\n{summary}")
-        stored = {row["key"]: row for row in job_rows(args.store, [j for js in jobs.values() for j in js])}
+        stored = {row["key"]: row for row in job_rows(args.store, every)}
         rows = {name: [stored[j.key] for j in sorted(js, key=lambda j: j.key) if j.key in stored]
                 for name, js in jobs.items()}
+        grid_maps = maps_from_rows([stored[j.key] for j in sorted(grid, key=lambda j: j.key) if j.key in stored],
+                                   lambda config: cell_of(config, PLANNING_CELLS))
         results = {}
         for name, candidate_rows in rows.items():
             maps = maps_from_rows(candidate_rows, cell_of)
             paper_form = [r["error"] is None and r["est_betti0"] == r["true_betti0"]
                           and r["est_betti1"] == r["true_betti1"] for r in candidate_rows]
-            for pooling in POOLINGS:
+            for pooling in (CHOSEN[1],) if args.calibrate_only else POOLINGS:
                 fit = fit_thresholds(maps, pooling)
                 right = exact(maps, fit.thresholds, pooling)
-                cv = cross_validated(maps, pooling, CV_FOLDS)
+                cv = None if args.calibrate_only else cross_validated(maps, pooling, CV_FOLDS)
                 per_cell = {c.name: _rate([ok for m, ok in zip(maps, right) if m.cell == c.name]) for c in CELLS}
                 results[(name, pooling)] = {
                     "fit": fit, "maps": maps, "right": int(right.sum()), "cv": cv, "total": len(candidate_rows),
@@ -124,14 +142,23 @@ def main() -> None:
                 if getattr(defaults, k) != getattr(chosen_config, k)}
     if mismatch:
         raise SystemExit(f"MapConfig defaults differ from the chosen pipeline: {mismatch}; update swarmtopo/pipeline.py")
-    for name, key in (("default", CHOSEN), ("trace", CHOSEN_TRACE)):
+    shipped = load_classifier("default").thresholds_[1]
+    if args.calibrate_only and results[CHOSEN]["fit"].thresholds != shipped:
+        raise SystemExit(f"the tuning maps give {results[CHOSEN]['fit'].thresholds}, the shipped classifier has "
+                         f"{shipped}: run without --calibrate-only to refit the classifiers")
+    for name, key in (("default", CHOSEN),) if args.calibrate_only else (("default", CHOSEN), ("trace", CHOSEN_TRACE)):
         chosen = results[key]
         model = calibrated_classifier(chosen["maps"], chosen["fit"].thresholds, provenance={
             "name": name, "script": "scripts/tune_accuracy.py", "suite": SUITE, "pipeline": CANDIDATES[key[0]],
             "tuning_cases_per_cell": args.per_cell, "held_out_family": HELD_OUT_FAMILY,
             "tuning_maps": chosen["total"], "tuning_exact": chosen["right"] / chosen["total"], "swarmtopo": __version__},
-            pooling=chosen["fit"].pooling)
+            pooling=chosen["fit"].pooling, beyond=grid_maps if name == "default" else ())
         model.save(ROOT / "src" / "swarmtopo" / "data" / f"classifier-{name}.json")
+        print(f"classifier-{name}.json: confidence {model.calibration_['1']}")
+    if args.calibrate_only:
+        print(f"{len(grid_maps)} calibration-grid maps; wrote classifier-default.json's confidence "
+              f"({(time.perf_counter() - started) / 60:.1f} min)")
+        return
     job_minutes = sum(r["t_total"] for candidate_rows in rows.values() for r in candidate_rows) / 60
     trace, default_thresholds = results[CHOSEN_TRACE], results[CHOSEN]["fit"].thresholds
     transfer = exact(trace["maps"], default_thresholds, CHOSEN_TRACE[1])

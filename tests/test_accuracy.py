@@ -81,6 +81,22 @@ def test_planning_grid_has_cases_of_its_own_and_varies_swarm_size_and_duration_a
     assert not acc.cell_of(small.config).startswith("planning")  # the default cells are the suite's
 
 
+def test_calibration_grid_is_the_planning_grid_with_seeds_of_its_own_open_to_tuning_code():
+    with acc.tuning_session():
+        calibration = acc.calibration_jobs()
+    planning = acc.planning_jobs()
+    assert len(calibration) == len(acc.PLANNING_CELLS) * acc.CALIBRATION_PER_CELL
+    assert {j.sweep for j in calibration} == {"accuracy-calibration-default"}
+    seeds = {j.case_seed for j in calibration}
+    suite_seeds = {acc.case_seed(c, split, i) for c in acc.CELLS for split, n in
+                   (("tuning", acc.TUNING_PER_CELL), ("reporting", acc.REPORTING_PER_CELL)) for i in range(n)}
+    assert len(seeds) == len(calibration) and not seeds & suite_seeds and not seeds & {j.case_seed for j in planning}
+    # the same cells and pipeline as the planning grid, so the grid checks the confidence where it was fitted
+    assert sorted(acc.cell_of(j.config, acc.PLANNING_CELLS) for j in calibration) == sorted(
+        acc.cell_of(j.config, acc.PLANNING_CELLS) for j in planning)
+    assert {canonical_json(j.config["map"]) for j in calibration} == {canonical_json(j.config["map"]) for j in planning}
+
+
 def test_table_and_reliability_hand_computed():
     records = [{"cell": acc.CELLS[0].name, "held_out": False, "right": True, "betti1_right": True,
                 "confidence_betti1": 0.9} for _ in range(3)]

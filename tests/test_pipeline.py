@@ -441,6 +441,7 @@ def test_advice_comes_below_the_threshold_and_names_what_would_raise_it():
     import dataclasses
 
     from swarmtopo.pipeline import ADVICE_BELOW
+    from swarmtopo.ratio import RESOLUTION_CAP, resolution
 
     log = simulate(default_arena(), 150, 30.0, rng=2).log
     tmap = map_encounters(log, MapConfig(window_length=12.0, window_scales=(1.0,), **FAST))
@@ -451,6 +452,12 @@ def test_advice_comes_below_the_threshold_and_names_what_would_raise_it():
     assert advice[0] == f"beta_1 = {tmap.betti[1]} is uncertain ({100 * (ADVICE_BELOW - 0.2):.0f}% confidence)"
     assert advice[-1].startswith("to raise it: record longer") and "more agents than 150" in advice[-1]
     assert "swarmtopo plan" in advice[-1] and unsure.to_json()["advice"] == advice
+    # the windows' resolution, the confidence's second feature, is named when beta_1 is in doubt
+    places = np.exp(resolution([w.diagram for w in tmap.regions[0].windows]))
+    assert places < RESOLUTION_CAP
+    assert sum(f"tell about {places:.0f} places apart" in line for line in advice) == 1
+    only_beta0 = dataclasses.replace(tmap, confidence={0: ADVICE_BELOW - 0.2, 1: 0.99})
+    assert not any("places apart" in line for line in only_beta0.advice())
 
 
 def test_paper_pipeline_is_the_whole_log_without_hop_cost():

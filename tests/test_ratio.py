@@ -8,9 +8,12 @@ from hypothesis import strategies as st
 from swarmtopo.classify import load_classifier
 from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.persistence import Diagram
-from swarmtopo.ratio import (LOG_RATIO_CAP, MAX_MARGIN, SCORE_VAR_PRIOR, Z_CAP, RatioClassifier, RatioThresholds,
-                             longest_bars, median_vote, pooled_scores, region_reader, score_matrix, score_margin,
-                             standardised_margin, vote, window_scores)
+from scipy.special import expit
+
+from swarmtopo.pipeline import MapConfig
+from swarmtopo.ratio import (LOG_RATIO_CAP, MAX_MARGIN, RESOLUTION_CAP, SCORE_VAR_PRIOR, Z_CAP, RatioClassifier,
+                             RatioThresholds, longest_bars, median_vote, pooled_scores, region_reader, resolution,
+                             score_matrix, score_margin, standardised_margin, vote, window_scores)
 
 TH = RatioThresholds(q=0.5, tau=2.0)
 
@@ -119,6 +122,38 @@ def test_a_calibration_of_the_older_features_is_applied_as_fitted():
         RatioClassifier({1: TH}, calibration={"1": {"intercept": 0.0, "gap": 1.0}})
 
 
+def with_landmarks(n, h1=((1.0, 5.0),)):
+    """A window of n landmarks: n dim-0 bars (one infinite), and the given H1 bars."""
+    dim0 = np.array([[0.0, np.inf]] + [[0.0, 1.0]] * (n - 1))
+    return Diagram(pairs=(dim0, np.array(h1, dtype=float).reshape(-1, 2)), backend="test")
+
+
+def test_resolution_is_the_mean_log_landmark_count_capped_at_the_automatic_cap():
+    # windows of 10 and 1000 landmarks: (ln 10 + ln 400) / 2; the cap is the automatic count's
+    w = [with_landmarks(10), with_landmarks(1000)]
+    assert resolution(w) == pytest.approx((np.log(10) + np.log(RESOLUTION_CAP)) / 2)
+    assert RatioClassifier({1: TH}).region_features(w, 1)["resolution"] == resolution(w)
+    assert RESOLUTION_CAP == MapConfig().max_landmarks
+    assert resolution([with_landmarks(1)]) == 0.0
+
+
+def test_a_calibration_of_z_and_resolution_is_applied_as_fitted_and_one_of_z_alone_ignores_resolution():
+    # logit = a + b z + c ln L + d z ln L, hand-computed
+    calibration = {"intercept": -3.0, "z": 1.2, "resolution": 0.5, "z_x_resolution": 0.25, "maps": 10}
+    model = RatioClassifier({1: TH}, calibration={"1": calibration})
+    sparse, fine = [with_landmarks(20)] * 3, [with_landmarks(300)] * 3  # same bars, same z
+    z = model.region_features(sparse, 1)["z"]
+    assert z == model.region_features(fine, 1)["z"] > 0
+    for windows, landmarks in ((sparse, 20), (fine, 300)):
+        ln_l = np.log(landmarks)
+        assert model.region_features(windows, 1)["z_x_resolution"] == pytest.approx(z * ln_l)
+        assert model.region_confidence(windows)[1] == pytest.approx(expit(-3.0 + 1.2 * z + 0.5 * ln_l + 0.25 * z * ln_l))
+    assert "resolution" in model.describe()["confidence"]
+    z_only = RatioClassifier({1: TH}, calibration={"1": {"intercept": -3.0, "z": 1.2}})
+    assert z_only.region_confidence(sparse)[1] == z_only.region_confidence(fine)[1] == pytest.approx(
+        expit(-3.0 + 1.2 * z))
+
+
 def test_median_vote_is_the_lower_median():
     assert median_vote([2]) == 2
     assert median_vote([1, 2]) == 1
@@ -224,6 +259,17 @@ def test_shipped_default_is_a_calibrated_mean_pooled_ratio_classifier_and_gated_
     assert gated.gated and 0 < gated.thresholds_[1].agreement < 1 and set(gated.calibration_) == {"1"}
     assert gated.thresholds_[1].q == model.thresholds_[1].q  # fitted from the default's q_1 and tau_1
     assert gated.provenance_["score_only"] == model.thresholds_[1].to_json()
+
+
+def test_shipped_default_confidence_rises_with_z_and_with_the_places_resolved():
+    # over the fitted range (50-400 landmarks per window, z >= 0 by construction): more
+    # standard errors from changing the vote and more places told apart both mean more trust
+    cal = load_classifier("default").calibration_["1"]
+    assert {"z", "resolution", "z_x_resolution"} <= set(cal) and "calibration-grid" in load_classifier(
+        "default").provenance_["calibration"]
+    z, ln_l = np.meshgrid(np.linspace(0, Z_CAP, 41), np.log(np.linspace(50, RESOLUTION_CAP, 36)), indexing="ij")
+    logit = cal["intercept"] + cal["z"] * z + cal["resolution"] * ln_l + cal["z_x_resolution"] * z * ln_l
+    assert np.all(np.diff(logit, axis=0) > 0) and np.all(np.diff(logit, axis=1) > 0)
 
 
 @pytest.mark.parametrize("key, value, message", [

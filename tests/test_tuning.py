@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from swarmtopo.experiments.tuning import (A_GRID, B_GRID, Q_GRID, TAU_GRID, TuningMap, calibrated_classifier,
-                                         cross_fitted_features, cross_validated, exact, fit_gate, fit_thresholds,
+                                         cross_fitted_features, cross_validated, exact, features_under, fit_gate,
+                                         fit_thresholds,
                                          gate_estimates, grid_estimates)
 from swarmtopo.persistence import Diagram
 from swarmtopo.ratio import RatioClassifier, RatioThresholds
@@ -68,6 +69,23 @@ def test_cross_fitted_calibration_is_confident_on_clean_maps():
     # every out-of-fold outcome is right: the smoothed rate (30 + 1) / (30 + 2)
     confidence = model.region_confidence(maps[0].regions[0])[1]
     assert np.isclose(confidence, 31 / 32)
+
+
+def test_calibration_grid_maps_join_the_cross_fitted_ones_read_with_the_final_thresholds():
+    rng = np.random.default_rng(5)
+    maps, grid = synthetic_maps(30, rng), synthetic_maps(8, rng)
+    grid[0] = dataclasses.replace(grid[0], true_betti1=grid[0].true_betti1 + 1)  # wrong under any thresholds
+    grid[1] = dataclasses.replace(grid[1], est_betti0=2)  # beta_0 wrong: no beta_1 outcome
+    th = fit_thresholds(maps).thresholds
+    features, correct = features_under(grid, th)
+    assert len(features) == 7 and correct == [False] + [True] * 6
+    assert features[0] == RatioClassifier({1: th}).region_features(grid[0].regions[0], 1)
+    model = calibrated_classifier(maps, th, provenance={"name": "t"}, folds=3, beyond=grid)
+    assert model.provenance_["calibration"] == "3-fold cross-fitted on 30 tuning maps and 7 calibration-grid maps"
+    assert model.calibration_["1"]["maps"] == 37
+    # 36 of 37 outcomes right, and the wrong one has the features of many right ones: below 36/37 at most
+    assert model.region_confidence(grid[0].regions[0])[1] < calibrated_classifier(
+        maps, th, provenance={}, folds=3).region_confidence(grid[0].regions[0])[1]
 
 
 def test_cross_validated_count_reads_every_map_once_with_out_of_fold_thresholds():

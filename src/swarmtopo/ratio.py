@@ -38,7 +38,7 @@ windows overlap) vetoes nothing.  A vetoed rank is dropped from every window's s
 vetoed}, and the windows' own counts, the representative window, the drawn bars and z
 below are those of the sequences without it.
 
-Confidence.  For each region the feature is the vote's *standardised margin* z:
+Confidence.  For each region the first feature is the vote's *standardised margin* z:
 how many standard errors the pooled scores are from changing the vote beta,
 
     z = min((S_beta - ln tau_n) / se_beta, (ln tau_n - S_{beta+1}) / se_{beta+1}),
@@ -47,11 +47,17 @@ how many standard errors the pooled scores are from changing the vote beta,
 v_k the variance over the W windows of their k-th scores (0 for one window) and
 SCORE_VAR_PRIOR a prior variance, so that a few windows that happen to agree do not
 make z infinite; a side without a rank counts as Z_CAP, and z is capped there.
-P(correct | z) is a logistic regression fitted on the benchmark's tuning maps
-(:meth:`RatioClassifier.calibrate`).  Files calibrated before z existed carry
-coefficients of the windows' *agreement* with the vote, the vote's log *margin*
-(capped at MAX_MARGIN) and the log number of *windows*; they are applied as they were
-fitted (:data:`REGION_FEATURES`).
+The second feature is the windows' *resolution* ln L: the mean over the windows of
+ln min(L_w, RESOLUTION_CAP), L_w the number of landmarks of window w (its dim-0 bars:
+the places it tells apart).  Windows agree on a wrong count too when they resolve few
+places (a sparse swarm, a short log): no bar at all is then a confident "no hole".
+P(correct) is a logistic regression of z, ln L and z ln L (so that the windows'
+agreement weighs more the more places they resolve), fitted on the benchmark's tuning maps and
+on a calibration grid of swarms and logs beyond the suite's budgets
+(:meth:`RatioClassifier.calibrate`, ``scripts/tune_accuracy.py``); files calibrated on z
+alone are applied so.  Files calibrated before z existed carry coefficients of the
+windows' *agreement* with the vote, the vote's log *margin* (capped at MAX_MARGIN) and
+the log number of *windows*; they are applied as they were fitted (:data:`REGION_FEATURES`).
 
 Earlier files (/1, /2) could also gate bars by death/birth ratio, length in covering
 radii and a largest-gap rule; measured over three tuning rounds they never raised the
@@ -86,13 +92,17 @@ Z_CAP = 10.0
 """Cap of the standardised margin z (ten standard errors from changing is as sure as it gets)."""
 SCORE_VAR_PRIOR = 0.25 ** 2
 """Prior variance of a window's score at one rank (log units squared): se_k never falls below 0.25 / sqrt(W)."""
-CONFIDENCE_FEATURES = ("z",)
+RESOLUTION_CAP = 400
+"""Landmark count at which a window's resolution saturates: the automatic count's cap
+(``MapConfig.max_landmarks``) in every map the confidence was calibrated on, so a larger
+``--max-landmarks`` does not read as a resolution never calibrated."""
+CONFIDENCE_FEATURES = ("z", "resolution", "z_x_resolution")
 """The features :meth:`RatioClassifier.calibrate` fits."""
 OLD_FEATURES = ("agreement", "margin", "windows")
 """The features of files calibrated before z existed."""
-REGION_FEATURES = ("z", *OLD_FEATURES)
-"""Every feature :meth:`RatioClassifier.region_features` gives: a calibration weighs z or,
-in files calibrated before z, the other three."""
+REGION_FEATURES = (*CONFIDENCE_FEATURES, *OLD_FEATURES)
+"""Every feature :meth:`RatioClassifier.region_features` gives: a calibration weighs z, the
+resolution and their product, z alone, or (files calibrated before z) the other three."""
 LOG_RATIO_CAP = float(np.log(1e3))
 """Cap of a bar's score: a bar 1000 times the typical noise loop (or infinite) is as long as it gets."""
 
@@ -132,6 +142,13 @@ def window_scores(diagram: Diagram, dim: int, q: float) -> np.ndarray:
     else:  # no finite bar with a length (none, or all of length 0): only infinite bars score
         scores[finite] = 0.0
     return np.sort(scores)[::-1]
+
+
+def resolution(windows: Sequence[Diagram]) -> float:
+    """ln L of a region: the mean over its windows of ln min(L_w, RESOLUTION_CAP), L_w the
+    window's landmarks that are apart (its dim-0 bars: one per landmark, the zero-length
+    bars of coincident ones dropped)."""
+    return float(np.mean([np.log(max(1, min(len(w[0]), RESOLUTION_CAP))) for w in windows]))
 
 
 def confidence_model() -> LogisticRegression:
@@ -382,8 +399,9 @@ class RatioClassifier:
                 for n, th in self.thresholds_.items() if n <= maxdim}
 
     def region_features(self, windows: Sequence[Diagram], n: int, voted=None) -> dict[str, float]:
-        """One region's confidence features for dimension n: z (module docstring), and the
-        agreement, capped log margin and ln #windows that older calibrations use.
+        """One region's confidence features for dimension n: z, the resolution ln L and their
+        product (module docstring), and the agreement, capped log margin and ln #windows that
+        older calibrations use.
         ``voted`` is :func:`vote`'s result for these windows when the caller has it."""
         betti, rep, counts = voted or vote(self, windows)
         th = self.thresholds_[n]
@@ -392,7 +410,8 @@ class RatioClassifier:
             margin = self.margin(windows[rep], n)
         else:
             margin = score_margin(matrix.mean(axis=0), th.tau)
-        return {"z": standardised_margin(matrix, betti[n], th.tau),
+        z, ln_l = standardised_margin(matrix, betti[n], th.tau), resolution(windows)
+        return {"z": z, "resolution": ln_l, "z_x_resolution": z * ln_l,
                 "agreement": float(np.mean(np.asarray(counts[n]) == betti[n])),
                 "margin": margin, "windows": float(np.log(len(windows)))}
 
@@ -456,6 +475,10 @@ class RatioClassifier:
         model = self.calibration_.get("1")
         if model is None:
             return "uncalibrated"
+        if "resolution" in model:
+            return ("P(correct) from a logistic model of z, how many standard errors (over the windows) the pooled "
+                    "scores are from changing the vote, of the windows' resolution ln L (L landmarks, at most "
+                    f"{RESOLUTION_CAP}) and of z ln L, fitted on the benchmark's tuning maps and its calibration grid")
         if "z" in model:
             return ("P(correct) from a logistic model of z, how many standard errors (over the windows) the pooled "
                     "scores are from changing the vote, fitted on the benchmark's tuning maps")

@@ -101,6 +101,11 @@ PLANNING_CELLS: tuple[Cell, ...] = tuple(
 """The planning grid: cases ``plan`` is fitted on besides the reporting cases (split
 "planning", seeds of their own; all five hole families; no default is chosen on them)."""
 PLANNING_PER_CELL = 3
+CALIBRATION_PER_CELL = 3
+"""Cases per cell of the calibration grid: the planning grid's cells with seeds of their
+own (split "calibration"), on which the confidence is fitted besides the tuning maps
+(``scripts/tune_accuracy.py``), so that it holds for swarms and logs beyond the suite's
+budgets; the planning grid then checks it on cases it was not fitted on."""
 
 _session = {"tuning": False}
 
@@ -201,6 +206,11 @@ def planning_jobs(per_cell: int = PLANNING_PER_CELL, cells=PLANNING_CELLS) -> li
     """Jobs of the planning grid under the default pipeline (what ``plan`` is fitted on
     besides the reporting maps; the full ``swarmtopo bench accuracy`` runs them)."""
     return _jobs("planning", per_cell, {"default": PIPELINES["default"]}, cells)
+
+
+def calibration_jobs(per_cell: int = CALIBRATION_PER_CELL, cells=PLANNING_CELLS) -> list[Job]:
+    """Jobs of the calibration grid under the default pipeline (open to tuning code)."""
+    return _jobs("calibration", per_cell, {"default": PIPELINES["default"]}, cells)
 
 
 def has_held_out_family(config: dict[str, Any]) -> bool:
@@ -400,6 +410,17 @@ PIPELINE_LABELS = {"default": "swarmtopo default", "paper": "paper's methods, tr
                    "paper-theta": "paper's methods, paper's Theta*"}
 
 
+def _reliability_lines(rel: dict[str, Any], title: str) -> list[str]:
+    lines = ["", f"{title} ({rel['maps']} maps): Brier score {rel['brier']:.4f} against {rel['brier_constant']:.4f} "
+                 "for a constant confidence equal to the accuracy.", "",
+             "| confidence | maps | mean confidence | fraction right [Wilson 95 %] |", "|---|---|---|---|"]
+    for b in rel["bins"]:
+        lo, hi = b["wilson95"]
+        lines.append(f"| {b['low']:.2f}-{b['high']:.2f} | {b['maps']} | {b['mean_confidence']:.3f} | "
+                     f"{b['fraction_right']:.3f} [{lo:.2f}, {hi:.2f}] |")
+    return lines
+
+
 def markdown(summary: dict[str, Any], command: str) -> str:
     """The benchmark's tables as Markdown (what docs/accuracy.md quotes)."""
     names = list(summary["pipelines"])
@@ -435,14 +456,11 @@ def markdown(summary: dict[str, Any], command: str) -> str:
                 lines.append(f"| {n} x {t:g} s | {rate_text(Rate(sum(r['right'] for r in rows), len(rows)).to_json())} |")
     for n_dim in ("1", "0"):
         rel = summary["pipelines"]["default"]["reliability"][n_dim]
-        if not rel["maps"]:
-            continue
-        lines += ["", f"Reliability of the default pipeline's beta_{n_dim} confidence ({rel['maps']} maps): "
-                      f"Brier score {rel['brier']:.4f} against {rel['brier_constant']:.4f} for a constant "
-                      "confidence equal to the accuracy.", "",
-                  "| confidence | maps | mean confidence | fraction right [Wilson 95 %] |", "|---|---|---|---|"]
-        for b in rel["bins"]:
-            lo, hi = b["wilson95"]
-            lines.append(f"| {b['low']:.2f}-{b['high']:.2f} | {b['maps']} | {b['mean_confidence']:.3f} | "
-                         f"{b['fraction_right']:.3f} [{lo:.2f}, {hi:.2f}] |")
+        if rel["maps"]:
+            lines += _reliability_lines(rel, f"Reliability of the default pipeline's beta_{n_dim} confidence")
+    planning_reliability = reliability(summary.get("planning") or [], 1)
+    if planning_reliability["maps"]:
+        lines += _reliability_lines(planning_reliability, "Reliability of the beta_1 confidence on the planning grid "
+                                    "(swarms and logs beyond the suite's budgets; the confidence is fitted on the "
+                                    "tuning maps and the calibration grid, not on these)")
     return "\n".join(lines) + "\n"

@@ -182,41 +182,59 @@ def fit_gate(maps: Sequence[TuningMap], q: float) -> RatioThresholds:
     return RatioThresholds(q, float(np.exp(A_GRID[i])), float(B_GRID[j]))
 
 
+def one_region(maps: Sequence[TuningMap]) -> list[TuningMap]:
+    """The maps whose beta_0 is 1 and right: a region's beta_1 outcome is known only when
+    the map has one region (the truth is per map)."""
+    return [m for m in maps if m.true_betti0 == 1 and m.est_betti0 == 1]
+
+
+def features_under(maps: Sequence[TuningMap], th: RatioThresholds,
+                   pooling: str = "mean") -> tuple[list[dict[str, float]], list[bool]]:
+    """Confidence features (:meth:`~swarmtopo.ratio.RatioClassifier.region_features`) and
+    outcomes of the one-region ``maps`` read with thresholds ``th``."""
+    single = one_region(maps)
+    model = RatioClassifier({1: th}, pooling=pooling)
+    return ([_reader(model, m, 0).region_features(m.regions[0], 1) for m in single],
+            [bool(ok) for ok in exact(single, th, pooling)])
+
+
 def cross_fitted_features(maps: Sequence[TuningMap], pooling: str = "mean",
                           folds: int = 5, refit=None) -> tuple[list[dict[str, float]], list[bool]]:
     """Confidence features and outcomes of the one-region maps, each read with thresholds
     fitted without it.
 
-    The maps whose beta_0 is 1 and right (a region's outcome is known only when the
-    map has one region: the truth is per map) are split into ``folds`` by position;
-    for each fold the thresholds are refitted on the other folds, and the fold's
-    regions get their :meth:`~swarmtopo.ratio.RatioClassifier.region_features` and
-    whether their beta_1 is right from that refit.  ``refit(maps) -> RatioThresholds``
-    (default: :func:`fit_thresholds` with ``pooling``) is how the thresholds are refitted.
+    The one-region maps (:func:`one_region`) are split into ``folds`` by position; for
+    each fold the thresholds are refitted on the other folds, and the fold's regions get
+    their features and whether their beta_1 is right from that refit
+    (:func:`features_under`).  ``refit(maps) -> RatioThresholds`` (default:
+    :func:`fit_thresholds` with ``pooling``) is how the thresholds are refitted.
     """
     refit = refit or (lambda subset: fit_thresholds(subset, pooling).thresholds)
-    single = [m for m in maps if m.true_betti0 == 1 and m.est_betti0 == 1]
+    single = one_region(maps)
     fold = np.arange(len(single)) % folds
     features, correct = [], []
     for k in range(folds):
-        held = [m for m, f in zip(single, fold) if f == k]
-        th = refit([m for m, f in zip(single, fold) if f != k])
-        model = RatioClassifier({1: th}, pooling=pooling)
-        features += [_reader(model, m, 0).region_features(m.regions[0], 1) for m in held]
-        correct += [bool(ok) for ok in exact(held, th, pooling)]
+        held_features, held_correct = features_under([m for m, f in zip(single, fold) if f == k],
+                                                     refit([m for m, f in zip(single, fold) if f != k]), pooling)
+        features += held_features
+        correct += held_correct
     return features, correct
 
 
 def calibrated_classifier(maps: Sequence[TuningMap], thresholds: RatioThresholds, provenance: dict,
-                          pooling: str = "mean", folds: int = 5, refit=None) -> RatioClassifier:
+                          pooling: str = "mean", folds: int = 5, refit=None,
+                          beyond: Sequence[TuningMap] = ()) -> RatioClassifier:
     """The classifier of the fitted ``thresholds`` with its confidence calibrated by cross-fitting.
 
-    The thresholds were chosen on these very maps, so their outcomes under them are
-    optimistic.  The logistic model is fitted on out-of-fold features and outcomes
-    (:func:`cross_fitted_features`, thresholds refitted by ``refit``) and then used with
-    the final thresholds.
+    The thresholds were chosen on ``maps``, so their outcomes under them are
+    optimistic.  The logistic model is fitted on their out-of-fold features and outcomes
+    (:func:`cross_fitted_features`, thresholds refitted by ``refit``) and on those of
+    the ``beyond`` maps (the calibration grid: no threshold was chosen on them) read
+    with the final thresholds, and then used with the final thresholds.
     """
     features, correct = cross_fitted_features(maps, pooling, folds, refit)
-    model = RatioClassifier({1: thresholds}, provenance={**provenance, "calibration": f"{folds}-fold cross-fitted"},
-                            pooling=pooling)
-    return model.calibrate(features, correct)
+    more_features, more_correct = features_under(beyond, thresholds, pooling)
+    model = RatioClassifier({1: thresholds}, provenance={**provenance, "calibration": (
+        f"{folds}-fold cross-fitted" + (f" on {len(features)} tuning maps and {len(more_features)} calibration-grid "
+                                        "maps" if beyond else ""))}, pooling=pooling)
+    return model.calibrate(features + more_features, correct + more_correct)
