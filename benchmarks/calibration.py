@@ -8,8 +8,8 @@ features and outcome read with thresholds fitted without it
 each one-region calibration-grid map's read with the thresholds fitted on all tuning
 maps (no threshold is chosen on the grid).  For each feature set it fits the logistic
 P(right) of ``RatioClassifier.calibrate`` (``ratio.confidence_model``) on both, predicting
-each map from a model fitted without it (scikit-learn ``cross_val_predict``, 10 folds by
-position), and prints the Brier score (against a constant confidence equal to the rate)
+each map from a model fitted without it (scikit-learn ``cross_val_predict``, 10 folds,
+shuffled with seed 0: the maps are listed tuning first, grid last), and prints the Brier score (against a constant confidence equal to the rate)
 and log loss of those predictions, on the tuning maps and on the grid apart, with each
 one's reliability table in the bins of the accuracy benchmark.
 

@@ -135,8 +135,9 @@ def main() -> None:
                     "failed": len(candidate_rows) - len(maps), "per_cell": per_cell,
                     "paper_form": int(sum(paper_form)),
                     "seconds": float(np.mean([r["t_total"] for r in candidate_rows]))}
-                print(f"{name}, {pooling} pooling: {fit.thresholds}: {right.sum()}/{len(candidate_rows)} "
-                      f"({CV_FOLDS}-fold CV {cv}); paper form {sum(paper_form)}/{len(candidate_rows)}")
+                cv_text = "" if cv is None else f" ({CV_FOLDS}-fold CV {cv})"
+                print(f"{name}, {pooling} pooling: {fit.thresholds}: {right.sum()}/{len(candidate_rows)}{cv_text}; "
+                      f"paper form {sum(paper_form)}/{len(candidate_rows)}")
     defaults, chosen_config = MapConfig(), job_map_config(jobs[CHOSEN[0]][0].config["map"])
     mismatch = {k: (getattr(defaults, k), getattr(chosen_config, k)) for k in PIPELINE_FIELDS
                 if getattr(defaults, k) != getattr(chosen_config, k)}

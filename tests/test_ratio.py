@@ -12,7 +12,7 @@ from scipy.special import expit
 
 from swarmtopo.pipeline import MapConfig
 from swarmtopo.ratio import (LOG_RATIO_CAP, MAX_MARGIN, RESOLUTION_CAP, SCORE_VAR_PRIOR, Z_CAP, RatioClassifier,
-                             RatioThresholds, longest_bars, median_vote, pooled_scores, region_reader, resolution,
+                             RatioThresholds, below_full_resolution, longest_bars, median_vote, pooled_scores, region_reader, resolution,
                              score_matrix, score_margin, standardised_margin, vote, window_scores)
 
 TH = RatioThresholds(q=0.5, tau=2.0)
@@ -135,6 +135,10 @@ def test_resolution_is_the_mean_log_landmark_count_capped_at_the_automatic_cap()
     assert RatioClassifier({1: TH}).region_features(w, 1)["resolution"] == resolution(w)
     assert RESOLUTION_CAP == MapConfig().max_landmarks
     assert resolution([with_landmarks(1)]) == 0.0
+    # full resolution is the cap, whatever the floating point of exp(mean ln L)
+    assert not below_full_resolution([with_landmarks(RESOLUTION_CAP)] * 7)
+    assert not below_full_resolution([with_landmarks(1000), with_landmarks(RESOLUTION_CAP)])
+    assert below_full_resolution([with_landmarks(RESOLUTION_CAP), with_landmarks(RESOLUTION_CAP - 1)])
 
 
 def test_a_calibration_of_z_and_resolution_is_applied_as_fitted_and_one_of_z_alone_ignores_resolution():
@@ -149,6 +153,8 @@ def test_a_calibration_of_z_and_resolution_is_applied_as_fitted_and_one_of_z_alo
         assert model.region_features(windows, 1)["z_x_resolution"] == pytest.approx(z * ln_l)
         assert model.region_confidence(windows)[1] == pytest.approx(expit(-3.0 + 1.2 * z + 0.5 * ln_l + 0.25 * z * ln_l))
     assert "resolution" in model.describe()["confidence"]
+    with pytest.raises(InputError, match="'resolution' and 'z_x_resolution' together"):
+        RatioClassifier({1: TH}, calibration={"1": {"intercept": -3.0, "z": 1.2, "resolution": 0.5}})
     z_only = RatioClassifier({1: TH}, calibration={"1": {"intercept": -3.0, "z": 1.2}})
     assert z_only.region_confidence(sparse)[1] == z_only.region_confidence(fine)[1] == pytest.approx(
         expit(-3.0 + 1.2 * z))

@@ -11,7 +11,7 @@ from swarmtopo.experiments.tuning import (A_GRID, B_GRID, Q_GRID, TAU_GRID, Tuni
                                          fit_thresholds,
                                          gate_estimates, grid_estimates)
 from swarmtopo.persistence import Diagram
-from swarmtopo.ratio import RatioClassifier, RatioThresholds
+from swarmtopo.ratio import CONFIDENCE_FEATURES, RatioClassifier, RatioThresholds
 
 
 def window(holes, rng):
@@ -83,6 +83,9 @@ def test_calibration_grid_maps_join_the_cross_fitted_ones_read_with_the_final_th
     model = calibrated_classifier(maps, th, provenance={"name": "t"}, folds=3, beyond=grid)
     assert model.provenance_["calibration"] == "3-fold cross-fitted on 30 tuning maps and 7 calibration-grid maps"
     assert model.calibration_["1"]["maps"] == 37
+    # the grid gives the resolution a range: its features are fitted only with grid maps
+    assert set(model.calibration_["1"]) == {"intercept", "maps", *CONFIDENCE_FEATURES}
+    assert set(calibrated_classifier(maps, th, provenance={}, folds=3).calibration_["1"]) == {"intercept", "maps", "z"}
     # 36 of 37 outcomes right, and the wrong one has the features of many right ones: below 36/37 at most
     assert model.region_confidence(grid[0].regions[0])[1] < calibrated_classifier(
         maps, th, provenance={}, folds=3).region_confidence(grid[0].regions[0])[1]

@@ -38,7 +38,8 @@ from .landmarks import SUBSAMPLERS, Landmarks, knn_distances, knn_maxmin, maxmin
 from .log import EncounterLog, exact_time
 from .persistence import Diagram, PersistenceResult, rips_persistence
 from .agreement import overlapping, rank_agreement, window_coordinates
-from .ratio import RESOLUTION_CAP, RatioClassifier, longest_bars, region_reader, resolution, vote
+from .ratio import (RESOLUTION_CAP, RatioClassifier, below_full_resolution, longest_bars, region_reader, resolution,
+                    vote)
 
 
 MIN_REGION_AGENTS = 3
@@ -389,11 +390,11 @@ class TopologicalMap:
             counts = [w.betti.get(1) for w in r.windows]
             if len(set(counts)) > 1:
                 lines.append(f"region {r.component}: its {len(counts)} time windows counted {counts} holes each")
-            places = np.exp(resolution([w.diagram for w in r.windows]))
-            if 1 in low and places < RESOLUTION_CAP:
-                lines.append(f"region {r.component}: its windows tell about {places:.0f} places apart (landmarks; the "
-                             f"confidence is calibrated up to {RESOLUTION_CAP}): with few places a hole can go unseen "
-                             "in every window alike, so agreeing windows are no proof")
+            diagrams = [w.diagram for w in r.windows]
+            if 1 in low and below_full_resolution(diagrams):
+                lines.append(f"region {r.component}: its windows tell about {np.exp(resolution(diagrams)):.0f} places "
+                             f"apart (landmarks; {RESOLUTION_CAP} at full resolution): with few places a hole can go "
+                             "unseen in every window alike, so agreeing windows are no proof")
         length = self.window_length[0]
         more_time = ("" if self.windows_left_out else
                      f"record longer (each extra {self.config.window_step or length / 2:.3g} s adds a window to "

@@ -151,6 +151,12 @@ def resolution(windows: Sequence[Diagram]) -> float:
     return float(np.mean([np.log(max(1, min(len(w[0]), RESOLUTION_CAP))) for w in windows]))
 
 
+def below_full_resolution(windows: Sequence[Diagram]) -> bool:
+    """Whether the windows average fewer than RESOLUTION_CAP landmarks (in log units, so
+    that windows all at the cap are at full resolution)."""
+    return resolution(windows) < np.log(RESOLUTION_CAP) - 1e-9
+
+
 def confidence_model() -> LogisticRegression:
     """The (unfitted) logistic model :meth:`RatioClassifier.calibrate` fits on :func:`confidence_design`."""
     return LogisticRegression(C=1.0)
@@ -274,9 +280,9 @@ class RatioClassifier:
     thresholds
         ``{n: RatioThresholds(q_n, tau_n)}`` for each homology dimension n >= 1.
     calibration
-        Per dimension the logistic P(correct): ``{"intercept", "z"}`` (older files:
-        ``"agreement", "margin", "windows"``; :meth:`region_features`); None =
-        uncalibrated.  (beta_0's confidence is the pipeline's: :mod:`swarmtopo.beta0`.)
+        Per dimension the logistic P(correct): ``{"intercept", "z", "resolution",
+        "z_x_resolution"}``, ``{"intercept", "z"}`` or (older files) ``{"intercept",
+        "agreement", "margin", "windows"}`` (:meth:`region_features`); None = uncalibrated.  (beta_0's confidence is the pipeline's: :mod:`swarmtopo.beta0`.)
     provenance
         Free-form record of how it was fitted (name, data, script).
     pooling
@@ -310,6 +316,9 @@ class RatioClassifier:
             if unknown:
                 raise InputError(f"unknown confidence feature(s) {sorted(unknown)}; known: "
                                  f"{', '.join(REGION_FEATURES)}", column=f"calibration.{n}", value=model)
+            if isinstance(model, dict) and ("resolution" in model) != ("z_x_resolution" in model):
+                raise InputError("a calibration weighs 'resolution' and 'z_x_resolution' together, or neither",
+                                 column=f"calibration.{n}", value=model)
             if not isinstance(model, dict) or "intercept" not in model or not (
                     "z" in model or set(OLD_FEATURES) <= set(model)):
                 raise InputError(f"a calibration needs 'intercept' and 'z' (older files: 'intercept', "
@@ -433,22 +442,23 @@ class RatioClassifier:
         return out
 
     # -- fitting -------------------------------------------------------------------------
-    def calibrate(self, features: Sequence[dict[str, float]], correct) -> "RatioClassifier":
-        """Fit P(correct | CONFIDENCE_FEATURES) for dimension 1.
+    def calibrate(self, features: Sequence[dict[str, float]], correct,
+                  names: Sequence[str] = CONFIDENCE_FEATURES) -> "RatioClassifier":
+        """Fit P(correct | the ``names`` features) for dimension 1.
 
         ``features[k]`` are region k's (:meth:`region_features`, of this or of another
         classifier when the outcomes are cross-fitted) and ``correct[k]`` whether its
         vote was right.
         """
-        X = confidence_design(features)
+        X = confidence_design(features, names)
         y = np.asarray(correct, dtype=bool)
         if len(np.unique(y)) == 2:
             model = confidence_model().fit(X, y)
             intercept, coefficients = float(model.intercept_[0]), model.coef_[0]
         else:  # all right (or all wrong): the smoothed rate, whatever the features
             rate = (y.sum() + 1) / (len(y) + 2)
-            intercept, coefficients = float(np.log(rate / (1 - rate))), np.zeros(len(CONFIDENCE_FEATURES))
-        self.calibration_ = {"1": {"intercept": intercept, **dict(zip(CONFIDENCE_FEATURES, map(float, coefficients))),
+            intercept, coefficients = float(np.log(rate / (1 - rate))), np.zeros(len(names))
+        self.calibration_ = {"1": {"intercept": intercept, **dict(zip(names, map(float, coefficients))),
                                    "maps": int(len(y))}}
         return self
 

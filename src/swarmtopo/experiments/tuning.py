@@ -7,7 +7,8 @@ each candidate fits the :class:`~swarmtopo.ratio.RatioClassifier` thresholds
 only which bars count, so no job is rerun -- for each way of pooling the windows, with
 a cross-validated count beside the fitted one (:func:`cross_validated`).  The
 confidence model of the chosen candidate is then fitted on the same tuning maps,
-cross-fitted (:func:`calibrated_classifier`, :func:`cross_fitted_features`).
+cross-fitted (:func:`calibrated_classifier`, :func:`cross_fitted_features`), and for
+the default classifier on the calibration grid's maps too (:func:`features_under`).
 
 ``scripts/fit_agreement_gate.py`` fits the ``gated`` preset from the default's q_1: the
 agreement gate (:func:`fit_gate`: the score threshold a = ln tau_1 and the agreement
@@ -25,7 +26,7 @@ from scipy.ndimage import uniform_filter, uniform_filter1d
 
 from ..persistence import Diagram
 from ..agreement import BARS, agreement_array
-from ..ratio import RatioClassifier, RatioThresholds, pooled_scores, region_reader, window_scores
+from ..ratio import CONFIDENCE_FEATURES, RatioClassifier, RatioThresholds, pooled_scores, region_reader, window_scores
 
 Q_GRID = (0.5, 0.6, 0.7, 0.8, 0.9)
 TAU_GRID = tuple(np.round(np.geomspace(1.2, 12.0, 80), 4))
@@ -230,11 +231,15 @@ def calibrated_classifier(maps: Sequence[TuningMap], thresholds: RatioThresholds
     optimistic.  The logistic model is fitted on their out-of-fold features and outcomes
     (:func:`cross_fitted_features`, thresholds refitted by ``refit``) and on those of
     the ``beyond`` maps (the calibration grid: no threshold was chosen on them) read
-    with the final thresholds, and then used with the final thresholds.
+    with the final thresholds, and then used with the final thresholds.  Its features
+    are CONFIDENCE_FEATURES with ``beyond`` maps and z alone without: the suite's maps
+    nearly all sit at the resolution cap, so only the grid gives ln L a range to be
+    fitted on.
     """
     features, correct = cross_fitted_features(maps, pooling, folds, refit)
     more_features, more_correct = features_under(beyond, thresholds, pooling)
+    names = CONFIDENCE_FEATURES if len(more_features) else ("z",)
     model = RatioClassifier({1: thresholds}, provenance={**provenance, "calibration": (
         f"{folds}-fold cross-fitted" + (f" on {len(features)} tuning maps and {len(more_features)} calibration-grid "
                                         "maps" if beyond else ""))}, pooling=pooling)
-    return model.calibrate(features + more_features, correct + more_correct)
+    return model.calibrate(features + more_features, correct + more_correct, names)
