@@ -20,6 +20,7 @@ Feature sets: ``z`` (how many standard errors the pooled scores are from changin
 vote, ``ratio.standardised_margin``; the previous calibration); z and the windows'
 resolution ln L (``ratio.resolution``); those and z ln L (shipped); those and ln #windows;
 the calibration before z (agreement of the windows with the vote, log margin, ln #windows).
+Each is fitted on both sets; last, z fitted on the tuning maps alone, as before the grid.
 
     python benchmarks/calibration.py [--store tuning.duckdb]
 """
@@ -87,13 +88,17 @@ def main() -> None:
     print(f"{args.store}: {len(maps)} default-pipeline tuning maps, {len(correct)} with one region, "
           f"{int((~y[~on_grid]).sum())} wrong when read with thresholds fitted without them; {len(grid)} "
           f"calibration-grid maps, {len(grid_correct)} with one region, {int((~y[on_grid]).sum())} wrong")
+    folds = KFold(10, shuffle=True, random_state=0)
     for name, columns in FEATURE_SETS.items():
         X = confidence_design(features + grid_features, columns)
-        p = cross_val_predict(confidence_model(), X, y, cv=KFold(10, shuffle=True, random_state=0),
-                              method="predict_proba")[:, 1]
+        p = cross_val_predict(confidence_model(), X, y, cv=folds, method="predict_proba")[:, 1]
         print(f"\n## {name}")
         _scores("tuning maps", y[~on_grid], p[~on_grid])
         _scores("calibration grid", y[on_grid], p[on_grid])
+    alone = cross_val_predict(confidence_model(), confidence_design(features, ("z",)), y[~on_grid], cv=folds,
+                              method="predict_proba")[:, 1]
+    print("\n## z fitted on the tuning maps alone (the calibration before the grid)")
+    _scores("tuning maps", y[~on_grid], alone)
 
 
 if __name__ == "__main__":

@@ -6,11 +6,15 @@ each classifier given, prints exact (beta_0, beta_1) over the reporting maps, pe
 and for the held-out family, with the Brier score of its beta_1 confidence; then per
 budget (the two rooms on their own) the wrong maps counting too many and too few holes
 and the held-out family's exact maps, and the range of the wrong maps' beta_1
-confidence.  Reading a
+confidence.  With ``--planning`` it reads the planning grid's maps instead (the full
+run's swarms and logs beyond the suite's budgets) and prints, per classifier, the
+reliability of the beta_1 confidence there, the mean confidence against the fraction
+right per swarm size, and the wrong maps said at 0.95 or more.  Reading a
 store made by an older swarmtopo (other grid columns) works too: only the columns the
 verdict needs are read, so two rounds' maps can be compared under one classifier.
 
     python benchmarks/reclassify.py --store bench.duckdb [--classifier default old.json ratio:median:0.7:4.08 ...]
+                                    [--planning]
 
 A classifier is a preset, a JSON file, or ``ratio:POOLING:Q:TAU``: the ratio classifier
 with thresholds (q_1, tau_1) pooled by POOLING (mean or median), uncalibrated (no
@@ -28,8 +32,8 @@ import argparse
 
 from swarmtopo.classify import load_classifier
 from swarmtopo.ratio import RatioClassifier, RatioThresholds
-from swarmtopo.experiments.accuracy import (CELLS, PIPELINES, accuracy_table, beta1_misses, most_windows, outcomes,
-                                            reliability)
+from swarmtopo.experiments.accuracy import (CELLS, PIPELINES, PLANNING_CELLS, accuracy_table, beta1_misses,
+                                            most_windows, outcomes, reliability)
 from swarmtopo.experiments.store import read_jobs
 from swarmtopo.experiments.sweep import map_input
 
@@ -51,7 +55,14 @@ def main() -> None:
     parser.add_argument("--store", required=True, help="a store written by swarmtopo bench accuracy")
     parser.add_argument("--classifier", nargs="+", default=["default"],
                         help="classifier presets or JSON files (default: the shipped one)")
+    parser.add_argument("--planning", action="store_true", help="read the planning grid's maps (the full run's)")
     args = parser.parse_args()
+    if args.planning:
+        rows = read_jobs(args.store, columns=COLUMNS, sweep="accuracy-planning-default")
+        print(f"{args.store}: {len(rows)} planning-grid maps")
+        for name in args.classifier:
+            print(_planning_summary(name, outcomes(rows, _classifier(name), cells=PLANNING_CELLS)))
+        return
     rows = default_rows(args.store)
     print(f"{args.store}: {len(rows)} default-pipeline maps, at most {most_windows(rows)} windows per region")
     for name in args.classifier:
@@ -70,6 +81,29 @@ def _classifier(name: str):
         _, pooling, q, tau = name.split(":")
         return RatioClassifier({1: RatioThresholds(float(q), float(tau))}, pooling=pooling)
     return load_classifier(name)
+
+
+def _planning_summary(name: str, records: list[dict]) -> str:
+    """The beta_1 confidence on the planning grid: reliability, per swarm size, confident misses."""
+    rel = reliability(records, 1)
+    if not rel["maps"]:
+        return f"{name}: uncalibrated"
+    lines = [f"{name}: {sum(r['right'] for r in records)}/{len(records)} exact; beta_1 confidence on {rel['maps']} "
+             f"maps: Brier {rel['brier']:.4f} (constant {rel['brier_constant']:.4f})"]
+    lines += [f"  {b['low']:.2f}-{b['high']:.2f}: {b['maps']} maps, said {b['mean_confidence']:.3f}, right "
+              f"{b['fraction_right']:.3f} [{b['wilson95'][0]:.2f}, {b['wilson95'][1]:.2f}]" for b in rel["bins"]]
+    rated = [r for r in records if r["confidence_betti1"] is not None]
+    for agents in sorted({r["agents"] for r in rated}):
+        mine = [r for r in rated if r["agents"] == agents]
+        wrong = [r["confidence_betti1"] for r in mine if not r["betti1_right"]]
+        lines.append(f"  {agents} agents: {len(mine)} maps, said {sum(r['confidence_betti1'] for r in mine) / len(mine):.2f}, "
+                     f"right {sum(r['betti1_right'] for r in mine) / len(mine):.2f}"
+                     + (f", wrong maps said {sum(wrong) / len(wrong):.2f}" if wrong else ""))
+    sure = [r for r in rated if not r["betti1_right"] and r["confidence_betti1"] >= 0.95]
+    lines.append("  wrong at 0.95 or more: " + (", ".join(
+        f"{r['agents']} x {r['duration']:g} s {r['true_betti1']}->{r['est_betti1']} ({r['confidence_betti1']:.3f})"
+        for r in sure) or "none"))
+    return "\n".join(lines)
 
 
 def _group(record: dict) -> str:

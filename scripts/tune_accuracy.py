@@ -143,8 +143,8 @@ def main() -> None:
                 if getattr(defaults, k) != getattr(chosen_config, k)}
     if mismatch:
         raise SystemExit(f"MapConfig defaults differ from the chosen pipeline: {mismatch}; update swarmtopo/pipeline.py")
-    shipped = load_classifier("default").thresholds_[1]
-    if args.calibrate_only and results[CHOSEN]["fit"].thresholds != shipped:
+    shipped = load_classifier("default").thresholds_[1] if args.calibrate_only else None
+    if shipped is not None and results[CHOSEN]["fit"].thresholds != shipped:
         raise SystemExit(f"the tuning maps give {results[CHOSEN]['fit'].thresholds}, the shipped classifier has "
                          f"{shipped}: run without --calibrate-only to refit the classifiers")
     for name, key in (("default", CHOSEN),) if args.calibrate_only else (("default", CHOSEN), ("trace", CHOSEN_TRACE)):

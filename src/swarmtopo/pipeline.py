@@ -390,8 +390,7 @@ class TopologicalMap:
             counts = [w.betti.get(1) for w in r.windows]
             if len(set(counts)) > 1:
                 lines.append(f"region {r.component}: its {len(counts)} time windows counted {counts} holes each")
-            diagrams = [w.diagram for w in r.windows]
-            if 1 in low and below_full_resolution(diagrams):
+            if 1 in low and below_full_resolution(diagrams := [w.diagram for w in r.windows]):
                 lines.append(f"region {r.component}: its windows tell about {np.exp(resolution(diagrams)):.0f} places "
                              f"apart (landmarks; {RESOLUTION_CAP} at full resolution): with few places a hole can go "
                              "unseen in every window alike, so agreeing windows are no proof")

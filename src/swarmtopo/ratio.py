@@ -52,8 +52,8 @@ ln min(L_w, RESOLUTION_CAP), L_w the number of landmarks of window w (its dim-0 
 the places it tells apart).  Windows agree on a wrong count too when they resolve few
 places (a sparse swarm, a short log): no bar at all is then a confident "no hole".
 P(correct) is a logistic regression of z, ln L and z ln L (so that the windows'
-agreement weighs more the more places they resolve), fitted on the benchmark's tuning maps and
-on a calibration grid of swarms and logs beyond the suite's budgets
+agreement weighs more the more places they resolve), fitted on the benchmark's tuning
+maps and on a calibration grid of swarms and logs beyond the suite's budgets
 (:meth:`RatioClassifier.calibrate`, ``scripts/tune_accuracy.py``); files calibrated on z
 alone are applied so.  Files calibrated before z existed carry coefficients of the
 windows' *agreement* with the vote, the vote's log *margin* (capped at MAX_MARGIN) and
@@ -282,7 +282,8 @@ class RatioClassifier:
     calibration
         Per dimension the logistic P(correct): ``{"intercept", "z", "resolution",
         "z_x_resolution"}``, ``{"intercept", "z"}`` or (older files) ``{"intercept",
-        "agreement", "margin", "windows"}`` (:meth:`region_features`); None = uncalibrated.  (beta_0's confidence is the pipeline's: :mod:`swarmtopo.beta0`.)
+        "agreement", "margin", "windows"}`` (:meth:`region_features`); None = uncalibrated.
+        (beta_0's confidence is the pipeline's: :mod:`swarmtopo.beta0`.)
     provenance
         Free-form record of how it was fitted (name, data, script).
     pooling

@@ -367,9 +367,10 @@ def run_benchmark(store, *, quick: bool = False, scheduler: str | None = None, w
     cases of each planning cell under the default pipeline; the summary document.
 
     Returns ``{"suite", "cases_per_cell", "seconds", "jobs_per_minute", "pipelines":
-    {name: {"table", "reliability"}}, "records", "planning"}`` with tables as from
-    :func:`accuracy_table` (``Rate`` objects as JSON), the records of the default
-    pipeline's reporting maps and of the planning maps (what ``plan`` is fitted on).
+    {name: {"table", "reliability"}}, "records", "planning", "planning_reliability"}``
+    with tables as from :func:`accuracy_table` (``Rate`` objects as JSON), the records of
+    the default pipeline's reporting maps and of the planning maps (what ``plan`` is
+    fitted on), and the beta_1 confidence's reliability on the planning maps.
     Each pipeline's maps are read by its shipped classifier (:func:`outcomes`);
     ``paper-theta`` is the paper pipeline's maps read by the paper's published Theta*.
     """
@@ -386,6 +387,7 @@ def run_benchmark(store, *, quick: bool = False, scheduler: str | None = None, w
     classifiers = {name: load_classifier(PIPELINES[name]["classifier"]) for name in PIPELINES}
     results = {name: outcomes(subset, classifiers[name]) for name, subset in by_pipeline.items()}
     results["paper-theta"] = outcomes(by_pipeline["paper"], load_classifier("paper"))
+    planning_records = outcomes(planning_rows, classifiers["default"], cells=planning_cells)
     return {
         "suite": SUITE, "cases_per_cell": per_cell, "maps": len(rows),
         "seconds": summary.seconds, "jobs_run": summary.run, "workers": summary.workers,
@@ -395,7 +397,8 @@ def run_benchmark(store, *, quick: bool = False, scheduler: str | None = None, w
                              "mean_seconds": float(np.mean([r["seconds"] for r in recs])) if recs else None}
                       for name, recs in results.items()},
         "records": results["default"],
-        "planning": outcomes(planning_rows, classifiers["default"], cells=planning_cells),
+        "planning": planning_records,
+        "planning_reliability": reliability(planning_records, 1),
     }
 
 
@@ -458,9 +461,8 @@ def markdown(summary: dict[str, Any], command: str) -> str:
         rel = summary["pipelines"]["default"]["reliability"][n_dim]
         if rel["maps"]:
             lines += _reliability_lines(rel, f"Reliability of the default pipeline's beta_{n_dim} confidence")
-    planning_reliability = reliability(summary.get("planning") or [], 1)
-    if planning_reliability["maps"]:
-        lines += _reliability_lines(planning_reliability, "Reliability of the beta_1 confidence on the planning grid "
+    if summary["planning_reliability"]["maps"]:
+        lines += _reliability_lines(summary["planning_reliability"], "Reliability of the beta_1 confidence on the planning grid "
                                     "(swarms and logs beyond the suite's budgets; the confidence is fitted on the "
                                     "tuning maps and the calibration grid, not on these)")
     return "\n".join(lines) + "\n"

@@ -238,8 +238,9 @@ def calibrated_classifier(maps: Sequence[TuningMap], thresholds: RatioThresholds
     """
     features, correct = cross_fitted_features(maps, pooling, folds, refit)
     more_features, more_correct = features_under(beyond, thresholds, pooling)
-    names = CONFIDENCE_FEATURES if len(more_features) else ("z",)
-    model = RatioClassifier({1: thresholds}, provenance={**provenance, "calibration": (
-        f"{folds}-fold cross-fitted" + (f" on {len(features)} tuning maps and {len(more_features)} calibration-grid "
-                                        "maps" if beyond else ""))}, pooling=pooling)
+    names, calibration = CONFIDENCE_FEATURES, (f"{folds}-fold cross-fitted on {len(features)} tuning maps and "
+                                               f"{len(more_features)} calibration-grid maps")
+    if not more_features:
+        names, calibration = ("z",), f"{folds}-fold cross-fitted"
+    model = RatioClassifier({1: thresholds}, provenance={**provenance, "calibration": calibration}, pooling=pooling)
     return model.calibrate(features + more_features, correct + more_correct, names)
