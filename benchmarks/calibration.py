@@ -13,7 +13,9 @@ shuffled with seed 0: the maps are listed tuning first, grid last), and prints t
 and log loss of those predictions, on the tuning maps and on the grid apart, with each
 one's reliability table in the bins of the accuracy benchmark.
 
-These are the default (score-only) classifier's maps; the ``gated`` preset's confidence
+These are the default (score-only) classifier's maps, or with ``--reading contact-trace``
+the ``trace`` classifier's (the same cases and grid read as contact traces, thresholds
+fitted on those maps); the ``gated`` preset's confidence
 is fitted on its own tuning maps by ``scripts/fit_agreement_gate.py`` (the shipped file on z).
 
 Feature sets: ``z`` (how many standard errors the pooled scores are from changing the
@@ -22,7 +24,7 @@ resolution ln L (``ratio.resolution``); those and z ln L (shipped); those and ln
 the calibration before z (agreement of the windows with the vote, log margin, ln #windows).
 Each is fitted on both sets; last, z fitted on the tuning maps alone, as before the grid.
 
-    python benchmarks/calibration.py [--store tuning.duckdb]
+    python benchmarks/calibration.py [--store tuning.duckdb] [--reading contact-trace]
 """
 
 from __future__ import annotations
@@ -78,14 +80,16 @@ def _scores(name: str, y: np.ndarray, p: np.ndarray) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--store", default="tuning.duckdb", help="a store written by scripts/tune_accuracy.py")
+    parser.add_argument("--reading", choices=("log", "contact-trace"), default="log",
+                        help="the maps of log folders (default classifier) or of contact traces (trace classifier)")
     args = parser.parse_args()
-    maps, grid = default_maps(args.store), default_maps(args.store, split="calibration")
+    maps, grid = default_maps(args.store, args.reading), default_maps(args.store, args.reading, split="calibration")
     print(f"at most {max(len(region) for m in maps for region in m.regions)} windows per region")
     features, correct = cross_fitted_features(maps, "mean")
     grid_features, grid_correct = features_under(grid, fit_thresholds(maps, "mean").thresholds, "mean")
     y = np.array(correct + grid_correct)
     on_grid = np.arange(len(y)) >= len(correct)
-    print(f"{args.store}: {len(maps)} default-pipeline tuning maps, {len(correct)} with one region, "
+    print(f"{args.store}: {len(maps)} default-pipeline tuning maps ({args.reading}), {len(correct)} with one region, "
           f"{int((~y[~on_grid]).sum())} wrong when read with thresholds fitted without them; {len(grid)} "
           f"calibration-grid maps, {len(grid_correct)} with one region, {int((~y[on_grid]).sum())} wrong")
     folds = KFold(10, shuffle=True, random_state=0)

@@ -20,10 +20,14 @@ log and seconds per map; then the reliability of the beta_1 confidence over all 
 regimes' maps (Brier score against a constant, and its bins).
 
     python benchmarks/outside_suite.py [--per-regime 12] [--first 0] [--regimes NAME ...] [--set FIELD=VALUE ...]
+                                       [--contact-trace]
 
 ``--first`` is the index of the first case of each regime (``--first 12`` the next
 twelve); ``--set`` maps with ``MapConfig`` fields changed (as
-``benchmarks/levers.py``'s ``FIELD=VALUE`` variants: ``--set window_encounters=40``).
+``benchmarks/levers.py``'s ``FIELD=VALUE`` variants: ``--set window_encounters=40``);
+``--contact-trace`` maps each log's encounters only, as a real contact trace comes
+(``experiments.sweep.contact_trace``: no status, no r_d or speeds; ``map`` then reads it
+with the ``trace`` classifier).
 """
 
 from __future__ import annotations
@@ -39,7 +43,7 @@ import numpy as np
 from swarmtopo.arena import HOLE_SHAPES, OUTER_SHAPES, random_arena
 from swarmtopo.errors import SwarmtopoError
 from swarmtopo.experiments.accuracy import ROOM_SIDE, Rate, reliability
-from swarmtopo.experiments.sweep import stripped_log
+from swarmtopo.experiments.sweep import contact_trace, stripped_log
 from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.plan import load_plan
 from swarmtopo.sim import MotionParams, SensingParams, simulate
@@ -107,7 +111,7 @@ def _arena(regime_name: str, regime: Regime, index: int):
 
 
 def _run(task):
-    regime_name, index, options = task
+    regime_name, index, options, as_trace = task
     regime = REGIMES[regime_name]
     arena, seed, family, area = _arena(regime_name, regime, index)
     motion = MotionParams(**regime.motion)
@@ -115,7 +119,7 @@ def _run(task):
     sim = simulate(arena, regime.agents, regime.duration, dt=dt, motion=motion,
                    sensing=SensingParams(r_d=regime.r_d), static_fraction=regime.static_fraction,
                    rng=seed % 2**32)
-    log = stripped_log(sim.log)
+    log = contact_trace(stripped_log(sim.log)) if as_trace else stripped_log(sim.log)
     start = time.perf_counter()
     try:
         tmap = map_encounters(log, MapConfig(seed=seed % 2**32, embed_dim=0, cycles=False, **options))
@@ -133,10 +137,11 @@ def main() -> None:
     parser.add_argument("--regimes", nargs="*", default=list(REGIMES), help="regime names (a prefix is enough)")
     parser.add_argument("--set", nargs="*", default=[], metavar="FIELD=VALUE", help="MapConfig fields to change")
     parser.add_argument("--processes", type=int, default=2)
+    parser.add_argument("--contact-trace", action="store_true", help="map the encounters only (a contact trace)")
     args = parser.parse_args()
     options = {k: v for text in args.set for k, v in config_override(text).items()}
     names = [n for n in REGIMES if any(n.startswith(p) for p in args.regimes)]
-    tasks = [(name, i, options) for name in names for i in range(args.first, args.first + args.per_regime)]
+    tasks = [(name, i, options, args.contact_trace) for name in names for i in range(args.first, args.first + args.per_regime)]
     with ProcessPoolExecutor(args.processes) as pool:
         results = list(pool.map(_run, tasks))
     plan = load_plan()

@@ -9,12 +9,14 @@ and the held-out family's exact maps, and the range of the wrong maps' beta_1
 confidence.  With ``--planning`` it reads the planning grid's maps instead (the full
 run's swarms and logs beyond the suite's budgets) and prints, per classifier, the
 reliability of the beta_1 confidence there, the mean confidence against the fraction
-right per swarm size, and the wrong maps said at 0.95 or more.  Reading a
+right per swarm size, and the wrong maps said at 0.95 or more.  ``--reading
+contact-trace`` reads the maps of the same cases read as contact traces instead
+(``benchmarks/trace_accuracy.py``'s store, with ``--planning`` for the grid).  Reading a
 store made by an older swarmtopo (other grid columns) works too: only the columns the
 verdict needs are read, so two rounds' maps can be compared under one classifier.
 
     python benchmarks/reclassify.py --store bench.duckdb [--classifier default old.json ratio:median:0.7:4.08 ...]
-                                    [--planning]
+                                    [--planning] [--reading contact-trace]
 
 A classifier is a preset, a JSON file, or ``ratio:POOLING:Q:TAU``: the ratio classifier
 with thresholds (q_1, tau_1) pooled by POOLING (mean or median), uncalibrated (no
@@ -42,12 +44,17 @@ COLUMNS = ("key", "config", "replicate", "diagrams", "error", "est_betti0", "con
 """The columns the verdict needs (``accuracy.outcomes``)."""
 
 
-def default_rows(store: str) -> list[dict]:
+READINGS = {"log": "default", "contact-trace": "contact-trace"}
+"""What the maps read (``experiments.sweep.INPUTS``) -> the pipeline name in their sweep's name."""
+
+
+def default_rows(store: str, reading: str = "log") -> list[dict]:
     """The store's reporting rows of the default pipeline (its ``classifier`` is "default",
-    reading the whole log folder; not the planning grid's), sorted by key."""
-    return [row for row in read_jobs(store, columns=COLUMNS, sweep="accuracy-reporting-default")
+    reading the whole log folder, or only its encounters with ``reading="contact-trace"``;
+    not the planning grid's), sorted by key."""
+    return [row for row in read_jobs(store, columns=COLUMNS, sweep=f"accuracy-reporting-{READINGS[reading]}")
             if row["config"]["map"].get("classifier") == PIPELINES["default"]["classifier"]
-            and map_input(row["config"]["map"]) == "log"]
+            and map_input(row["config"]["map"]) == reading]
 
 
 def main() -> None:
@@ -56,15 +63,18 @@ def main() -> None:
     parser.add_argument("--classifier", nargs="+", default=["default"],
                         help="classifier presets or JSON files (default: the shipped one)")
     parser.add_argument("--planning", action="store_true", help="read the planning grid's maps (the full run's)")
+    parser.add_argument("--reading", choices=tuple(READINGS), default="log",
+                        help="the maps of the cases read as log folders (the bench's) or as contact traces "
+                             "(encounters only: benchmarks/trace_accuracy.py's store)")
     args = parser.parse_args()
     if args.planning:
-        rows = read_jobs(args.store, columns=COLUMNS, sweep="accuracy-planning-default")
-        print(f"{args.store}: {len(rows)} planning-grid maps")
+        rows = read_jobs(args.store, columns=COLUMNS, sweep=f"accuracy-planning-{READINGS[args.reading]}")
+        print(f"{args.store}: {len(rows)} planning-grid maps ({args.reading})")
         for name in args.classifier:
-            print(_planning_summary(name, outcomes(rows, _classifier(name), cells=PLANNING_CELLS)))
+            print(planning_summary(name, outcomes(rows, _classifier(name), cells=PLANNING_CELLS)))
         return
-    rows = default_rows(args.store)
-    print(f"{args.store}: {len(rows)} default-pipeline maps, at most {most_windows(rows)} windows per region")
+    rows = default_rows(args.store, args.reading)
+    print(f"{args.store}: {len(rows)} default-pipeline maps ({args.reading}), at most {most_windows(rows)} windows per region")
     for name in args.classifier:
         records = outcomes(rows, _classifier(name))
         table, rel = accuracy_table(records), reliability(records, 1)
@@ -83,7 +93,7 @@ def _classifier(name: str):
     return load_classifier(name)
 
 
-def _planning_summary(name: str, records: list[dict]) -> str:
+def planning_summary(name: str, records: list[dict]) -> str:
     """The beta_1 confidence on the planning grid: reliability, per swarm size, confident misses."""
     rel = reliability(records, 1)
     if not rel["maps"]:

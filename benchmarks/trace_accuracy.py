@@ -10,9 +10,13 @@ tuning cases only) or by any shipped classifiers named, it prints exact (beta_0,
 beta_1) per cell with Wilson 95 % intervals, the held-out family, and the Brier score
 of the beta_1 confidence.  Given the store of a ``swarmtopo bench accuracy`` run of the
 same cases (``--compare``), it prints the full log folders' figures beside them and the
-maps each reading alone gets right.
+maps each reading alone gets right.  ``--planning`` also maps the planning grid's cases
+(100-800 agents x 15-120 s, beyond the suite's budgets) as contact traces and prints,
+per classifier, the beta_1 confidence's reliability there (as ``reclassify.py
+--planning``): the trace classifier's confidence is fitted on the calibration grid read
+the same way, never on these cases.
 
-    python benchmarks/trace_accuracy.py --store trace.duckdb [--compare full.duckdb] [--quick]
+    python benchmarks/trace_accuracy.py --store trace.duckdb [--compare full.duckdb] [--quick] [--planning]
                                         [--classifier trace default]
 """
 
@@ -21,14 +25,13 @@ from __future__ import annotations
 import argparse
 import time
 
+from reclassify import planning_summary
 from swarmtopo.classify import load_classifier
-from swarmtopo.experiments.accuracy import (CELLS, PIPELINES, QUICK_PER_CELL, REPORTING_PER_CELL, accuracy_table,
-                                            beta1_misses, most_windows, outcomes, rate_text, reliability, reporting_jobs)
+from swarmtopo.experiments.accuracy import (CELLS, PIPELINES, PLANNING_CELLS, QUICK_PER_CELL, REPORTING_PER_CELL,
+                                            TRACE_READING, accuracy_table, beta1_misses, most_windows, outcomes,
+                                            planning_jobs, rate_text, reliability, reporting_jobs)
 from swarmtopo.experiments.store import job_rows
 from swarmtopo.experiments.sweep import run_sweep
-
-TRACE = {**PIPELINES["default"], "input": "contact-trace"}
-"""The default pipeline reading only the encounters of each case's log folder."""
 
 
 def main() -> None:
@@ -41,13 +44,16 @@ def main() -> None:
     parser.add_argument("--classifier", nargs="+", default=["trace"],
                         help="shipped classifiers to read the contact traces' maps with (default: trace, what "
                              "`map` uses for a log without status changes)")
+    parser.add_argument("--planning", action="store_true",
+                        help="also map the planning grid as contact traces and print the confidence's reliability there")
     args = parser.parse_args()
     per_cell = QUICK_PER_CELL if args.quick else REPORTING_PER_CELL
-    jobs = reporting_jobs(per_cell, pipelines={"contact-trace": TRACE})
+    jobs = reporting_jobs(per_cell, pipelines={"contact-trace": TRACE_READING})
+    grid = planning_jobs(reading="contact-trace") if args.planning else []
     start = time.perf_counter()
-    summary = run_sweep(jobs, args.store, workers=args.workers)
-    print(f"{len(jobs)} contact-trace maps ({per_cell} per cell), {summary.run} run in "
-          f"{(time.perf_counter() - start) / 60:.1f} min on {summary.workers} Dask workers")
+    summary = run_sweep(jobs + grid, args.store, workers=args.workers)
+    print(f"{len(jobs)} contact-trace maps ({per_cell} per cell) and {len(grid)} of the planning grid, "
+          f"{summary.run} run in {(time.perf_counter() - start) / 60:.1f} min on {summary.workers} Dask workers")
     rows = job_rows(args.store, jobs)  # each job's stored diagrams, read by each classifier (whatever the job ran)
     print(f"at most {most_windows(rows)} windows per region")
     columns = {f"contact trace, {name} classifier": outcomes(rows, load_classifier(name)) for name in args.classifier}
@@ -78,6 +84,11 @@ def main() -> None:
             trace_right = {(r["cell"], r["index"]) for r in records if r["right"]}
             print(f"{name}: right only as a contact trace {len(trace_right - full_right)}, "
                   f"only with the full log folder {len(full_right - trace_right)}")
+    if grid:
+        grid_rows = job_rows(args.store, grid)
+        print(f"\nplanning grid read as contact traces ({len(grid_rows)} maps):")
+        for name in args.classifier:
+            print(planning_summary(name, outcomes(grid_rows, load_classifier(name), cells=PLANNING_CELLS)))
 
 
 if __name__ == "__main__":

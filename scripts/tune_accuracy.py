@@ -16,7 +16,8 @@ writes
   classifier, ``scripts/fit_agreement_gate.py``, starts from its q_1 and tau_1);
 * ``src/swarmtopo/data/classifier-trace.json``: the same for ``CHOSEN_TRACE``, the
   chosen pipeline reading the tuning cases as contact traces (encounters only), which
-  ``map`` uses for a log without status changes;
+  ``map`` uses for a log without status changes; its confidence is calibrated on the
+  calibration grid read as contact traces too;
 * ``docs/tuning.md``: every candidate's tuning accuracy (ratio classifier and the
   paper-form classifier), so what did not help is on record.
 
@@ -27,14 +28,14 @@ one draw moves the count of a candidate by several maps.  The choice rests on
 run fits the chosen classifier and puts the rest on record.  The chosen pipeline's
 options are the defaults of ``MapConfig``; the script stops with an error if they differ.
 
-``--calibrate-only`` maps only the chosen candidate's tuning cases and the calibration
-grid, stops unless they give the shipped thresholds, and rewrites the default
-classifier's confidence alone.
+``--calibrate-only [default] [trace]`` maps only the named classifiers' candidates
+(both when none is named) on the tuning cases and the calibration grid, stops unless
+they give the shipped thresholds, and rewrites those classifiers' confidence alone.
 
 Usage::
 
     python scripts/tune_accuracy.py [--store tuning.duckdb] [--per-cell 20] [--workers N] [--scheduler ADDR]
-                                    [--calibrate-only]
+                                    [--calibrate-only [default] [trace]]
 """
 
 from __future__ import annotations
@@ -88,6 +89,10 @@ CHOSEN_TRACE = ("the first, reading a contact trace (encounters only: h from the
 """The default pipeline on logs without status changes (real contact traces): its own
 thresholds and calibration, the ``trace`` classifier, fitted on the same tuning cases
 read as contact traces (``experiments.sweep.contact_trace``)."""
+SHIPPED = {"default": CHOSEN, "trace": CHOSEN_TRACE}
+"""The classifier files this script writes, and the candidate and pooling each is fitted on."""
+GRID_READING = {"default": "default", "trace": "contact-trace"}
+"""How each shipped classifier's calibration grid is read (``experiments.accuracy.GRID_READINGS``)."""
 CV_FOLDS = 4
 """Folds of the cross-validated count printed beside each fitted one (thresholds refitted without each fold)."""
 
@@ -98,37 +103,40 @@ def main() -> None:
     parser.add_argument("--per-cell", type=int, default=TUNING_PER_CELL)
     parser.add_argument("--workers", type=int, default=None)
     parser.add_argument("--scheduler", default=None)
-    parser.add_argument("--calibrate-only", action="store_true",
-                        help="map only the chosen pipeline's tuning cases and the calibration grid, check that they "
-                             "give the shipped thresholds and rewrite classifier-default.json's confidence "
-                             "(docs/tuning.md and the trace classifier are left as they are)")
+    parser.add_argument("--calibrate-only", nargs="*", choices=tuple(SHIPPED), metavar="CLASSIFIER",
+                        help="map only these classifiers' candidates (default and trace when none is named) on the "
+                             "tuning cases and the calibration grid, check that they give the shipped thresholds "
+                             "and rewrite the classifiers' confidence (docs/tuning.md is left as it is)")
     args = parser.parse_args()
 
     started = time.perf_counter()
-    candidates = {CHOSEN[0]: CANDIDATES[CHOSEN[0]]} if args.calibrate_only else CANDIDATES
+    calibrate_only = args.calibrate_only is not None
+    shipping = tuple(dict.fromkeys(args.calibrate_only or SHIPPED))  # the classifier files written
+    candidates = {SHIPPED[n][0]: CANDIDATES[SHIPPED[n][0]] for n in shipping} if calibrate_only else CANDIDATES
     with tuning_session():
         pipelines = {name: {"metric": "hybrid", "classifier": "paper-form", **options}
                      for name, options in candidates.items()}
         jobs = {name: tuning_jobs({name: p}, per_cell=args.per_cell) for name, p in pipelines.items()}
-        grid = calibration_jobs()
-        every = [j for js in jobs.values() for j in js] + grid
+        grids = {n: calibration_jobs(reading=GRID_READING[n]) for n in shipping}
+        every = [j for js in (*jobs.values(), *grids.values()) for j in js]
         summary = run_sweep(every, args.store, scheduler=args.scheduler, workers=args.workers,
                             progress=lambda done, total, failed: print(f"\r{done}/{total} jobs", end="", flush=True))
         print(f"\n{summary}")
         stored = {row["key"]: row for row in job_rows(args.store, every)}
         rows = {name: [stored[j.key] for j in sorted(js, key=lambda j: j.key) if j.key in stored]
                 for name, js in jobs.items()}
-        grid_maps = maps_from_rows([stored[j.key] for j in sorted(grid, key=lambda j: j.key) if j.key in stored],
-                                   lambda config: cell_of(config, PLANNING_CELLS))
+        grid_maps = {n: maps_from_rows([stored[j.key] for j in sorted(grid, key=lambda j: j.key) if j.key in stored],
+                                       lambda config: cell_of(config, PLANNING_CELLS))
+                     for n, grid in grids.items()}
         results = {}
         for name, candidate_rows in rows.items():
             maps = maps_from_rows(candidate_rows, cell_of)
             paper_form = [r["error"] is None and r["est_betti0"] == r["true_betti0"]
                           and r["est_betti1"] == r["true_betti1"] for r in candidate_rows]
-            for pooling in (CHOSEN[1],) if args.calibrate_only else POOLINGS:
+            for pooling in [SHIPPED[n][1] for n in shipping if SHIPPED[n][0] == name] if calibrate_only else POOLINGS:
                 fit = fit_thresholds(maps, pooling)
                 right = exact(maps, fit.thresholds, pooling)
-                cv = None if args.calibrate_only else cross_validated(maps, pooling, CV_FOLDS)
+                cv = None if calibrate_only else cross_validated(maps, pooling, CV_FOLDS)
                 per_cell = {c.name: _rate([ok for m, ok in zip(maps, right) if m.cell == c.name]) for c in CELLS}
                 results[(name, pooling)] = {
                     "fit": fit, "maps": maps, "right": int(right.sum()), "cv": cv, "total": len(candidate_rows),
@@ -138,26 +146,29 @@ def main() -> None:
                 cv_text = "" if cv is None else f" ({CV_FOLDS}-fold CV {cv})"
                 print(f"{name}, {pooling} pooling: {fit.thresholds}: {right.sum()}/{len(candidate_rows)}{cv_text}; "
                       f"paper form {sum(paper_form)}/{len(candidate_rows)}")
-    defaults, chosen_config = MapConfig(), job_map_config(jobs[CHOSEN[0]][0].config["map"])
+    defaults, chosen_config = MapConfig(), job_map_config(jobs[SHIPPED[shipping[0]][0]][0].config["map"])
     mismatch = {k: (getattr(defaults, k), getattr(chosen_config, k)) for k in PIPELINE_FIELDS
                 if getattr(defaults, k) != getattr(chosen_config, k)}
     if mismatch:
         raise SystemExit(f"MapConfig defaults differ from the chosen pipeline: {mismatch}; update swarmtopo/pipeline.py")
-    shipped = load_classifier("default").thresholds_[1] if args.calibrate_only else None
-    if shipped is not None and results[CHOSEN]["fit"].thresholds != shipped:
-        raise SystemExit(f"the tuning maps give {results[CHOSEN]['fit'].thresholds}, the shipped classifier has "
-                         f"{shipped}: run without --calibrate-only to refit the classifiers")
-    for name, key in (("default", CHOSEN),) if args.calibrate_only else (("default", CHOSEN), ("trace", CHOSEN_TRACE)):
+    for name in shipping if calibrate_only else ():
+        fitted, shipped = results[SHIPPED[name]]["fit"].thresholds, load_classifier(name).thresholds_[1]
+        if fitted != shipped:
+            raise SystemExit(f"the tuning maps give {fitted} for {name}, the shipped classifier has {shipped}: "
+                             "run without --calibrate-only to refit the classifiers")
+    for name in shipping:
+        key = SHIPPED[name]
         chosen = results[key]
         model = calibrated_classifier(chosen["maps"], chosen["fit"].thresholds, provenance={
             "name": name, "script": "scripts/tune_accuracy.py", "suite": SUITE, "pipeline": CANDIDATES[key[0]],
             "tuning_cases_per_cell": args.per_cell, "held_out_family": HELD_OUT_FAMILY,
             "tuning_maps": chosen["total"], "tuning_exact": chosen["right"] / chosen["total"], "swarmtopo": __version__},
-            pooling=chosen["fit"].pooling, beyond=grid_maps if name == "default" else ())
+            pooling=chosen["fit"].pooling, beyond=grid_maps[name])
         model.save(ROOT / "src" / "swarmtopo" / "data" / f"classifier-{name}.json")
-        print(f"classifier-{name}.json: confidence {model.calibration_['1']}")
-    if args.calibrate_only:
-        print(f"{len(grid_maps)} calibration-grid maps; wrote classifier-default.json's confidence "
+        print(f"classifier-{name}.json: confidence {model.calibration_['1']} "
+              f"({len(grid_maps[name])} calibration-grid maps)")
+    if calibrate_only:
+        print(f"wrote the confidence of {', '.join(f'classifier-{n}.json' for n in shipping)} "
               f"({(time.perf_counter() - started) / 60:.1f} min)")
         return
     job_minutes = sum(r["t_total"] for candidate_rows in rows.values() for r in candidate_rows) / 60

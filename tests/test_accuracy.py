@@ -97,6 +97,22 @@ def test_calibration_grid_is_the_planning_grid_with_seeds_of_its_own_open_to_tun
     assert {canonical_json(j.config["map"]) for j in calibration} == {canonical_json(j.config["map"]) for j in planning}
 
 
+def test_grids_read_as_contact_traces_are_the_same_cases_with_encounters_only():
+    with acc.tuning_session():
+        calibration = acc.calibration_jobs()
+        traces = acc.calibration_jobs(reading="contact-trace")
+    for grid, read in ((calibration, traces), (acc.planning_jobs(), acc.planning_jobs(reading="contact-trace"))):
+        assert [(j.case_seed, j.config["arena"], j.config["swarm"]) for j in read] == [
+            (j.case_seed, j.config["arena"], j.config["swarm"]) for j in grid]
+        assert {j.config["map"].get("input") for j in read} == {"contact-trace"}
+        assert {j.config["map"].get("input") for j in grid} == {None}
+        assert not {j.key for j in read} & {j.key for j in grid}
+        assert {j.config["map"]["classifier"] for j in read} == {"default"}  # the trace classifier is chosen by map
+    assert {j.sweep for j in traces} == {"accuracy-calibration-contact-trace"}
+    with pytest.raises(KeyError):
+        acc.planning_jobs(reading="whole log")
+
+
 def test_table_and_reliability_hand_computed():
     records = [{"cell": acc.CELLS[0].name, "held_out": False, "right": True, "betti1_right": True,
                 "confidence_betti1": 0.9} for _ in range(3)]
@@ -173,6 +189,10 @@ def test_benchmark_runs_both_pipelines_on_dask_and_renders_its_table(tmp_path):
     rows = reclassify.default_rows(str(tmp_path / "acc.duckdb"))
     assert len(rows) == len(cells)
     assert acc.outcomes(rows, load_classifier("default")) == summary["records"]
+    assert reclassify.default_rows(str(tmp_path / "acc.duckdb"), "contact-trace") == []  # no map read as a trace
+    grid_text = reclassify.planning_summary("default", again["planning"])
+    assert "1/1 exact" in grid_text or "0/1 exact" in grid_text
+    assert re.search(r"^  200 agents: 1 maps, said 0\.\d\d, right [01]\.00", grid_text, re.M)
 
 
 def test_contact_trace_keeps_only_the_encounters_and_maps_from_them():

@@ -267,12 +267,14 @@ def test_shipped_default_is_a_calibrated_mean_pooled_ratio_classifier_and_gated_
     assert gated.provenance_["score_only"] == model.thresholds_[1].to_json()
 
 
-def test_shipped_default_confidence_rises_with_z_and_with_the_places_resolved():
+@pytest.mark.parametrize("name", ["default", "trace"])
+def test_shipped_confidence_rises_with_z_and_with_the_places_resolved(name):
     # over the fitted range (50-400 landmarks per window, z >= 0 by construction): more
     # standard errors from changing the vote and more places told apart both mean more trust
-    cal = load_classifier("default").calibration_["1"]
+    # (the trace classifier's fitted on the calibration grid read as contact traces)
+    cal = load_classifier(name).calibration_["1"]
     assert {"z", "resolution", "z_x_resolution"} <= set(cal) and "calibration-grid" in load_classifier(
-        "default").provenance_["calibration"]
+        name).provenance_["calibration"]
     z, ln_l = np.meshgrid(np.linspace(0, Z_CAP, 41), np.log(np.linspace(50, RESOLUTION_CAP, 36)), indexing="ij")
     logit = cal["intercept"] + cal["z"] * z + cal["resolution"] * ln_l + cal["z_x_resolution"] * z * ln_l
     assert np.all(np.diff(logit, axis=0) > 0) and np.all(np.diff(logit, axis=1) > 0)

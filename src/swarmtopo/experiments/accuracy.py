@@ -202,15 +202,24 @@ def reporting_jobs(per_cell: int = REPORTING_PER_CELL, pipelines=None, cells=CEL
     return _jobs("reporting", per_cell, pipelines or PIPELINES, cells)
 
 
-def planning_jobs(per_cell: int = PLANNING_PER_CELL, cells=PLANNING_CELLS) -> list[Job]:
+TRACE_READING = {**PIPELINES["default"], "input": "contact-trace"}
+"""The default pipeline reading only a case's encounters, as a real contact trace comes
+(``experiments.sweep.contact_trace``: no status changes, no r_d or speeds)."""
+GRID_READINGS = {"default": PIPELINES["default"], "contact-trace": TRACE_READING}
+"""How the planning and calibration grids may be read: log folders or contact traces."""
+
+
+def planning_jobs(per_cell: int = PLANNING_PER_CELL, cells=PLANNING_CELLS, reading: str = "default") -> list[Job]:
     """Jobs of the planning grid under the default pipeline (what ``plan`` is fitted on
-    besides the reporting maps; the full ``swarmtopo bench accuracy`` runs them)."""
-    return _jobs("planning", per_cell, {"default": PIPELINES["default"]}, cells)
+    besides the reporting maps; the full ``swarmtopo bench accuracy`` runs them), the
+    cases read as log folders or (``reading="contact-trace"``) as contact traces."""
+    return _jobs("planning", per_cell, {reading: GRID_READINGS[reading]}, cells)
 
 
-def calibration_jobs(per_cell: int = CALIBRATION_PER_CELL, cells=PLANNING_CELLS) -> list[Job]:
-    """Jobs of the calibration grid under the default pipeline (open to tuning code)."""
-    return _jobs("calibration", per_cell, {"default": PIPELINES["default"]}, cells)
+def calibration_jobs(per_cell: int = CALIBRATION_PER_CELL, cells=PLANNING_CELLS, reading: str = "default") -> list[Job]:
+    """Jobs of the calibration grid under the default pipeline (open to tuning code),
+    read as log folders or as contact traces (``reading``, as :func:`planning_jobs`)."""
+    return _jobs("calibration", per_cell, {reading: GRID_READINGS[reading]}, cells)
 
 
 def has_held_out_family(config: dict[str, Any]) -> bool:
