@@ -37,7 +37,7 @@ from sklearn.model_selection import KFold, cross_val_predict
 
 from swarmtopo.experiments.accuracy import PLANNING_CELLS, cell_of, reliability
 from swarmtopo.experiments.store import read_jobs
-from swarmtopo.experiments.sweep import job_map_config, map_input
+from swarmtopo.experiments.sweep import INPUTS, job_map_config, map_input
 from swarmtopo.experiments.tuning import (PIPELINE_FIELDS, cross_fitted_features, features_under, fit_thresholds,
                                          maps_from_rows)
 from swarmtopo.pipeline import MapConfig
@@ -80,7 +80,7 @@ def _scores(name: str, y: np.ndarray, p: np.ndarray) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--store", default="tuning.duckdb", help="a store written by scripts/tune_accuracy.py")
-    parser.add_argument("--reading", choices=("log", "contact-trace"), default="log",
+    parser.add_argument("--reading", choices=INPUTS, default="log",
                         help="the maps of log folders (default classifier) or of contact traces (trace classifier)")
     args = parser.parse_args()
     maps, grid = default_maps(args.store, args.reading), default_maps(args.store, args.reading, split="calibration")

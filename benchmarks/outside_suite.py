@@ -27,7 +27,7 @@ twelve); ``--set`` maps with ``MapConfig`` fields changed (as
 ``benchmarks/levers.py``'s ``FIELD=VALUE`` variants: ``--set window_encounters=40``);
 ``--contact-trace`` maps each log's encounters only, as a real contact trace comes
 (``experiments.sweep.contact_trace``: no status, no r_d or speeds; ``map`` then reads it
-with the ``trace`` classifier).
+with the ``trace`` classifier; no plan figure is printed then: ``plan`` models log folders).
 """
 
 from __future__ import annotations
@@ -154,7 +154,7 @@ def main() -> None:
         total += len(right)
         low, high = Rate(len(right), len(rows)).interval
         expected = (f"plan expects {np.mean([plan.accuracy(r['area'], regime.agents, regime.duration, r['truth'][1]) for r in rows]):.2f}; "
-                    if regime.paper_swarm else "")
+                    if regime.paper_swarm and not args.contact_trace else "")  # plan models log folders
         conf_right = [r["confidence"] for r in right if r["confidence"] is not None]
         conf_wrong = [r["confidence"] for r in wrong if r["confidence"] is not None]
         listed = ", ".join(f"{r['family']} {r['truth'][1]}->{r['mapped'][1]} "

@@ -35,24 +35,20 @@ import argparse
 from swarmtopo.classify import load_classifier
 from swarmtopo.ratio import RatioClassifier, RatioThresholds
 from swarmtopo.experiments.accuracy import (CELLS, PIPELINES, PLANNING_CELLS, accuracy_table, beta1_misses,
-                                            most_windows, outcomes, reliability)
+                                            most_windows, outcomes, reading_name, reliability)
 from swarmtopo.experiments.store import read_jobs
-from swarmtopo.experiments.sweep import map_input
+from swarmtopo.experiments.sweep import INPUTS, map_input
 
 COLUMNS = ("key", "config", "replicate", "diagrams", "error", "est_betti0", "confidence_betti0", "true_betti0", "true_betti1",
            "t_total")
 """The columns the verdict needs (``accuracy.outcomes``)."""
 
 
-READINGS = {"log": "default", "contact-trace": "contact-trace"}
-"""What the maps read (``experiments.sweep.INPUTS``) -> the pipeline name in their sweep's name."""
-
-
 def default_rows(store: str, reading: str = "log") -> list[dict]:
     """The store's reporting rows of the default pipeline (its ``classifier`` is "default",
     reading the whole log folder, or only its encounters with ``reading="contact-trace"``;
     not the planning grid's), sorted by key."""
-    return [row for row in read_jobs(store, columns=COLUMNS, sweep=f"accuracy-reporting-{READINGS[reading]}")
+    return [row for row in read_jobs(store, columns=COLUMNS, sweep=f"accuracy-reporting-{reading_name(reading)}")
             if row["config"]["map"].get("classifier") == PIPELINES["default"]["classifier"]
             and map_input(row["config"]["map"]) == reading]
 
@@ -63,12 +59,12 @@ def main() -> None:
     parser.add_argument("--classifier", nargs="+", default=["default"],
                         help="classifier presets or JSON files (default: the shipped one)")
     parser.add_argument("--planning", action="store_true", help="read the planning grid's maps (the full run's)")
-    parser.add_argument("--reading", choices=tuple(READINGS), default="log",
+    parser.add_argument("--reading", choices=INPUTS, default="log",
                         help="the maps of the cases read as log folders (the bench's) or as contact traces "
                              "(encounters only: benchmarks/trace_accuracy.py's store)")
     args = parser.parse_args()
     if args.planning:
-        rows = read_jobs(args.store, columns=COLUMNS, sweep=f"accuracy-planning-{READINGS[args.reading]}")
+        rows = read_jobs(args.store, columns=COLUMNS, sweep=f"accuracy-planning-{reading_name(args.reading)}")
         print(f"{args.store}: {len(rows)} planning-grid maps ({args.reading})")
         for name in args.classifier:
             print(planning_summary(name, outcomes(rows, _classifier(name), cells=PLANNING_CELLS)))

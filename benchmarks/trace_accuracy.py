@@ -28,7 +28,7 @@ import time
 from reclassify import planning_summary
 from swarmtopo.classify import load_classifier
 from swarmtopo.experiments.accuracy import (CELLS, PIPELINES, PLANNING_CELLS, QUICK_PER_CELL, REPORTING_PER_CELL,
-                                            TRACE_READING, accuracy_table, beta1_misses, most_windows, outcomes,
+                                            TRACE_PIPELINE, accuracy_table, beta1_misses, most_windows, outcomes,
                                             planning_jobs, rate_text, reliability, reporting_jobs)
 from swarmtopo.experiments.store import job_rows
 from swarmtopo.experiments.sweep import run_sweep
@@ -48,7 +48,7 @@ def main() -> None:
                         help="also map the planning grid as contact traces and print the confidence's reliability there")
     args = parser.parse_args()
     per_cell = QUICK_PER_CELL if args.quick else REPORTING_PER_CELL
-    jobs = reporting_jobs(per_cell, pipelines={"contact-trace": TRACE_READING})
+    jobs = reporting_jobs(per_cell, pipelines={"contact-trace": TRACE_PIPELINE})
     grid = planning_jobs(reading="contact-trace") if args.planning else []
     start = time.perf_counter()
     summary = run_sweep(jobs + grid, args.store, workers=args.workers)

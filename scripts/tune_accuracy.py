@@ -91,8 +91,8 @@ thresholds and calibration, the ``trace`` classifier, fitted on the same tuning 
 read as contact traces (``experiments.sweep.contact_trace``)."""
 SHIPPED = {"default": CHOSEN, "trace": CHOSEN_TRACE}
 """The classifier files this script writes, and the candidate and pooling each is fitted on."""
-GRID_READING = {"default": "default", "trace": "contact-trace"}
-"""How each shipped classifier's calibration grid is read (``experiments.accuracy.GRID_READINGS``)."""
+GRID_READING = {"default": "log", "trace": "contact-trace"}
+"""How each shipped classifier's calibration grid is read (``experiments.sweep.INPUTS``)."""
 CV_FOLDS = 4
 """Folds of the cross-validated count printed beside each fitted one (thresholds refitted without each fold)."""
 

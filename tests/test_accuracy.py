@@ -109,7 +109,8 @@ def test_grids_read_as_contact_traces_are_the_same_cases_with_encounters_only():
         assert not {j.key for j in read} & {j.key for j in grid}
         assert {j.config["map"]["classifier"] for j in read} == {"default"}  # the trace classifier is chosen by map
     assert {j.sweep for j in traces} == {"accuracy-calibration-contact-trace"}
-    with pytest.raises(KeyError):
+    assert [j.key for j in acc.planning_jobs(reading="log")] == [j.key for j in acc.planning_jobs()]
+    with pytest.raises(SwarmtopoError, match="no reading 'whole log'"):
         acc.planning_jobs(reading="whole log")
 
 

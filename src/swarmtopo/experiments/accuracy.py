@@ -202,24 +202,37 @@ def reporting_jobs(per_cell: int = REPORTING_PER_CELL, pipelines=None, cells=CEL
     return _jobs("reporting", per_cell, pipelines or PIPELINES, cells)
 
 
-TRACE_READING = {**PIPELINES["default"], "input": "contact-trace"}
+TRACE_PIPELINE = {**PIPELINES["default"], "input": "contact-trace"}
 """The default pipeline reading only a case's encounters, as a real contact trace comes
 (``experiments.sweep.contact_trace``: no status changes, no r_d or speeds)."""
-GRID_READINGS = {"default": PIPELINES["default"], "contact-trace": TRACE_READING}
-"""How the planning and calibration grids may be read: log folders or contact traces."""
+READING_PIPELINES = {"log": PIPELINES["default"], "contact-trace": TRACE_PIPELINE}
+"""The default pipeline per reading of a case (``experiments.sweep.INPUTS``): its log
+folder, or its encounters only."""
 
 
-def planning_jobs(per_cell: int = PLANNING_PER_CELL, cells=PLANNING_CELLS, reading: str = "default") -> list[Job]:
+def reading_name(reading: str) -> str:
+    """The pipeline's name in the sweep names of the default pipeline's maps under
+    ``reading`` ("log" -> "default", as before there were readings)."""
+    if reading not in READING_PIPELINES:
+        raise SwarmtopoError(f"no reading {reading!r}: one of {', '.join(READING_PIPELINES)}")
+    return "default" if reading == "log" else reading
+
+
+def _default_jobs(split: str, per_cell: int, cells, reading: str) -> list[Job]:
+    return _jobs(split, per_cell, {reading_name(reading): READING_PIPELINES[reading]}, cells)
+
+
+def planning_jobs(per_cell: int = PLANNING_PER_CELL, cells=PLANNING_CELLS, reading: str = "log") -> list[Job]:
     """Jobs of the planning grid under the default pipeline (what ``plan`` is fitted on
     besides the reporting maps; the full ``swarmtopo bench accuracy`` runs them), the
     cases read as log folders or (``reading="contact-trace"``) as contact traces."""
-    return _jobs("planning", per_cell, {reading: GRID_READINGS[reading]}, cells)
+    return _default_jobs("planning", per_cell, cells, reading)
 
 
-def calibration_jobs(per_cell: int = CALIBRATION_PER_CELL, cells=PLANNING_CELLS, reading: str = "default") -> list[Job]:
+def calibration_jobs(per_cell: int = CALIBRATION_PER_CELL, cells=PLANNING_CELLS, reading: str = "log") -> list[Job]:
     """Jobs of the calibration grid under the default pipeline (open to tuning code),
     read as log folders or as contact traces (``reading``, as :func:`planning_jobs`)."""
-    return _jobs("calibration", per_cell, {reading: GRID_READINGS[reading]}, cells)
+    return _default_jobs("calibration", per_cell, cells, reading)
 
 
 def has_held_out_family(config: dict[str, Any]) -> bool:
