@@ -30,12 +30,13 @@ Each is fitted on both sets; last, z fitted on the tuning maps alone, as before 
 from __future__ import annotations
 
 import argparse
+from functools import partial
 
 import numpy as np
 from sklearn.metrics import log_loss
 from sklearn.model_selection import KFold, cross_val_predict
 
-from swarmtopo.experiments.accuracy import PLANNING_CELLS, cell_of, reliability
+from swarmtopo.experiments.accuracy import CELLS, PLANNING_CELLS, cell_of, reliability
 from swarmtopo.experiments.store import read_jobs
 from swarmtopo.experiments.sweep import INPUTS, job_map_config, map_input
 from swarmtopo.experiments.tuning import (PIPELINE_FIELDS, cross_fitted_features, features_under, fit_thresholds,
@@ -61,8 +62,8 @@ def default_maps(store: str, reading: str = "log", split: str = "tuning"):
     rows = [r for r in read_jobs(store, columns=COLUMNS) if map_input(r["config"]["map"]) == reading
             and r["sweep"].startswith(f"accuracy-{split}-")
             and all(getattr(job_map_config(r["config"]["map"]), k) == getattr(defaults, k) for k in PIPELINE_FIELDS)]
-    cells = PLANNING_CELLS if split == "calibration" else None
-    name = (lambda config: cell_of(config, cells)) if cells else cell_of
+    cells = PLANNING_CELLS if split == "calibration" else CELLS
+    name = partial(cell_of, cells=cells)
     rows.sort(key=lambda r: (r["replicate"], name(r["config"])))
     return maps_from_rows(rows, name)
 

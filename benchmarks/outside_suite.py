@@ -42,7 +42,7 @@ import numpy as np
 
 from swarmtopo.arena import HOLE_SHAPES, OUTER_SHAPES, random_arena
 from swarmtopo.errors import SwarmtopoError
-from swarmtopo.experiments.accuracy import ROOM_SIDE, Rate, reliability
+from swarmtopo.experiments.accuracy import ROOM_SIDE, Rate, reliability, reliability_bin_lines
 from swarmtopo.experiments.sweep import contact_trace, stripped_log
 from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.plan import load_plan
@@ -170,9 +170,7 @@ def main() -> None:
     if rel["maps"]:
         print(f"beta_1 confidence over all regimes ({rel['maps']} maps): Brier {rel['brier']:.4f} against "
               f"{rel['brier_constant']:.4f} for a constant equal to the rate")
-        for b in rel["bins"]:
-            print(f"  {b['low']:.2f}-{b['high']:.2f}: {b['maps']} maps, said {b['mean_confidence']:.3f}, "
-                  f"right {b['fraction_right']:.3f} [{b['wilson95'][0]:.2f}, {b['wilson95'][1]:.2f}]")
+        print("\n".join(reliability_bin_lines(rel)))
 
 
 if __name__ == "__main__":

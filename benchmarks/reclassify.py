@@ -35,7 +35,8 @@ import argparse
 from swarmtopo.classify import load_classifier
 from swarmtopo.ratio import RatioClassifier, RatioThresholds
 from swarmtopo.experiments.accuracy import (CELLS, PIPELINES, PLANNING_CELLS, accuracy_table, beta1_misses,
-                                            most_windows, outcomes, reading_name, reliability)
+                                            most_windows, outcomes, reading_name, reliability,
+                                            reliability_bin_lines)
 from swarmtopo.experiments.store import read_jobs
 from swarmtopo.experiments.sweep import INPUTS, map_input
 
@@ -96,8 +97,7 @@ def planning_summary(name: str, records: list[dict]) -> str:
         return f"{name}: uncalibrated"
     lines = [f"{name}: {sum(r['right'] for r in records)}/{len(records)} exact; beta_1 confidence on {rel['maps']} "
              f"maps: Brier {rel['brier']:.4f} (constant {rel['brier_constant']:.4f})"]
-    lines += [f"  {b['low']:.2f}-{b['high']:.2f}: {b['maps']} maps, said {b['mean_confidence']:.3f}, right "
-              f"{b['fraction_right']:.3f} [{b['wilson95'][0]:.2f}, {b['wilson95'][1]:.2f}]" for b in rel["bins"]]
+    lines += reliability_bin_lines(rel)
     rated = [r for r in records if r["confidence_betti1"] is not None]
     for agents in sorted({r["agents"] for r in rated}):
         mine = [r for r in rated if r["agents"] == agents]

@@ -51,11 +51,11 @@ from swarmtopo.classify import load_classifier
 from swarmtopo.experiments.accuracy import (CELLS, HELD_OUT_FAMILY, PLANNING_CELLS, SUITE, TUNING_PER_CELL, calibration_jobs,
                                            cell_of, tuning_jobs, tuning_session)
 from swarmtopo.experiments.store import job_rows
-from swarmtopo.experiments.sweep import job_map_config, run_sweep
+from swarmtopo.experiments.sweep import job_map_config, map_input, run_sweep
 from swarmtopo.experiments.tuning import (PIPELINE_FIELDS, Q_GRID, TAU_GRID, calibrated_classifier, cross_validated, exact,
                                          fit_thresholds, maps_from_rows)
 from swarmtopo.pipeline import MapConfig
-from swarmtopo.ratio import POOLINGS
+from swarmtopo.ratio import POOLINGS, confidence_readout
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -91,8 +91,6 @@ thresholds and calibration, the ``trace`` classifier, fitted on the same tuning 
 read as contact traces (``experiments.sweep.contact_trace``)."""
 SHIPPED = {"default": CHOSEN, "trace": CHOSEN_TRACE}
 """The classifier files this script writes, and the candidate and pooling each is fitted on."""
-GRID_READING = {"default": "log", "trace": "contact-trace"}
-"""How each shipped classifier's calibration grid is read (``experiments.sweep.INPUTS``)."""
 CV_FOLDS = 4
 """Folds of the cross-validated count printed beside each fitted one (thresholds refitted without each fold)."""
 
@@ -117,7 +115,8 @@ def main() -> None:
         pipelines = {name: {"metric": "hybrid", "classifier": "paper-form", **options}
                      for name, options in candidates.items()}
         jobs = {name: tuning_jobs({name: p}, per_cell=args.per_cell) for name, p in pipelines.items()}
-        grids = {n: calibration_jobs(reading=GRID_READING[n]) for n in shipping}
+        # each classifier's grid is read as its candidate reads the tuning cases (log folder or contact trace)
+        grids = {n: calibration_jobs(reading=map_input(CANDIDATES[SHIPPED[n][0]])) for n in shipping}
         every = [j for js in (*jobs.values(), *grids.values()) for j in js]
         summary = run_sweep(every, args.store, scheduler=args.scheduler, workers=args.workers,
                             progress=lambda done, total, failed: print(f"\r{done}/{total} jobs", end="", flush=True))
@@ -166,7 +165,7 @@ def main() -> None:
             pooling=chosen["fit"].pooling, beyond=grid_maps[name])
         model.save(ROOT / "src" / "swarmtopo" / "data" / f"classifier-{name}.json")
         print(f"classifier-{name}.json: confidence {model.calibration_['1']} "
-              f"({len(grid_maps[name])} calibration-grid maps)")
+              f"({len(grid_maps[name])} calibration-grid maps); {confidence_readout(model)}")
     if calibrate_only:
         print(f"wrote the confidence of {', '.join(f'classifier-{n}.json' for n in shipping)} "
               f"({(time.perf_counter() - started) / 60:.1f} min)")

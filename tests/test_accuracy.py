@@ -191,9 +191,11 @@ def test_benchmark_runs_both_pipelines_on_dask_and_renders_its_table(tmp_path):
     assert len(rows) == len(cells)
     assert acc.outcomes(rows, load_classifier("default")) == summary["records"]
     assert reclassify.default_rows(str(tmp_path / "acc.duckdb"), "contact-trace") == []  # no map read as a trace
+    (grid_map,) = again["planning"]
     grid_text = reclassify.planning_summary("default", again["planning"])
-    assert "1/1 exact" in grid_text or "0/1 exact" in grid_text
-    assert re.search(r"^  200 agents: 1 maps, said 0\.\d\d, right [01]\.00", grid_text, re.M)
+    assert f"default: {int(grid_map['right'])}/1 exact" in grid_text
+    assert (f"  200 agents: 1 maps, said {grid_map['confidence_betti1']:.2f}, "
+            f"right {float(grid_map['betti1_right']):.2f}") in grid_text
 
 
 def test_contact_trace_keeps_only_the_encounters_and_maps_from_them():

@@ -12,7 +12,7 @@ from scipy.special import expit
 
 from swarmtopo.pipeline import MapConfig
 from swarmtopo.ratio import (LOG_RATIO_CAP, MAX_MARGIN, RESOLUTION_CAP, SCORE_VAR_PRIOR, Z_CAP, RatioClassifier,
-                             RatioThresholds, below_full_resolution, longest_bars, median_vote, pooled_scores, region_reader, resolution,
+                             RatioThresholds, below_full_resolution, confidence_readout, longest_bars, median_vote, pooled_scores, region_reader, resolution,
                              score_matrix, score_margin, standardised_margin, vote, window_scores)
 
 TH = RatioThresholds(q=0.5, tau=2.0)
@@ -139,6 +139,19 @@ def test_resolution_is_the_mean_log_landmark_count_capped_at_the_automatic_cap()
     assert not below_full_resolution([with_landmarks(RESOLUTION_CAP)] * 7)
     assert not below_full_resolution([with_landmarks(1000), with_landmarks(RESOLUTION_CAP)])
     assert below_full_resolution([with_landmarks(RESOLUTION_CAP), with_landmarks(RESOLUTION_CAP - 1)])
+
+
+def test_confidence_readout_is_the_slope_of_z_and_the_confidence_at_z_zero_per_landmark_count():
+    # logit = -3 + 1.2 z + 0.5 ln L + 0.25 z ln L: at L = 1 the slope is 1.2 and P(z = 0) = expit(-3) = 0.047
+    model = RatioClassifier({1: TH}, calibration={"1": {"intercept": -3.0, "z": 1.2, "resolution": 0.5,
+                                                        "z_x_resolution": 0.25, "maps": 10}})
+    text = confidence_readout(model, landmarks=(1, int(round(np.exp(2)))))
+    assert text == ("L = 1: z's slope 1.20, P(right | z = 0) 0.05; "
+                    f"L = 7: z's slope {1.2 + 0.25 * np.log(7):.2f}, P(right | z = 0) "
+                    f"{1 / (1 + np.exp(3.0 - 0.5 * np.log(7))):.2f}")
+    z_alone = RatioClassifier({1: TH}, calibration={"1": {"intercept": 0.0, "z": 2.0, "maps": 10}})
+    assert confidence_readout(z_alone, landmarks=(20, 400)) == (
+        "L = 20: z's slope 2.00, P(right | z = 0) 0.50; L = 400: z's slope 2.00, P(right | z = 0) 0.50")
 
 
 def test_a_calibration_of_z_and_resolution_is_applied_as_fitted_and_one_of_z_alone_ignores_resolution():

@@ -157,6 +157,18 @@ def below_full_resolution(windows: Sequence[Diagram]) -> bool:
     return resolution(windows) < np.log(RESOLUTION_CAP) - 1e-9
 
 
+def confidence_readout(classifier: "RatioClassifier", landmarks: Sequence[int] = (RESOLUTION_CAP, 100, 20)) -> str:
+    """How a beta_1 calibration of z and the resolution reads at windows of ``landmarks``
+    landmarks (what docs/accuracy.md quotes): z's slope, the coefficient of z plus that of
+    z ln L times ln L, and P(right) at z = 0."""
+    model = classifier.calibration_["1"]
+    ln_l = np.log(np.asarray(landmarks, dtype=float))
+    slopes = model["z"] + model.get("z_x_resolution", 0.0) * ln_l
+    at_zero = expit(model["intercept"] + model.get("resolution", 0.0) * ln_l)
+    return "; ".join(f"L = {count}: z's slope {slope:.2f}, P(right | z = 0) {p:.2f}"
+                     for count, slope, p in zip(landmarks, slopes, at_zero))
+
+
 def confidence_model() -> LogisticRegression:
     """The (unfitted) logistic model :meth:`RatioClassifier.calibrate` fits on :func:`confidence_design`."""
     return LogisticRegression(C=1.0)

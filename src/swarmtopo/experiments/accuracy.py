@@ -374,6 +374,12 @@ def reliability(records: list[dict[str, Any]], n: int, edges: tuple[float, ...] 
             "brier_constant": float(np.mean((y.mean() - y) ** 2)), "maps": int(len(y))}
 
 
+def reliability_bin_lines(rel: dict[str, Any]) -> list[str]:
+    """:func:`reliability`'s bins as indented text lines (what the benchmark scripts print)."""
+    return [f"  {b['low']:.2f}-{b['high']:.2f}: {b['maps']} maps, said {b['mean_confidence']:.3f}, right "
+            f"{b['fraction_right']:.3f} [{b['wilson95'][0]:.2f}, {b['wilson95'][1]:.2f}]" for b in rel["bins"]]
+
+
 def case_area(config: dict[str, Any]) -> float:
     """Area (mm^2) inside the outer walls of a case: every outer wall of the suite has
     area (500 scale)^2, and two rooms twice that."""

@@ -7,8 +7,8 @@ each candidate fits the :class:`~swarmtopo.ratio.RatioClassifier` thresholds
 only which bars count, so no job is rerun -- for each way of pooling the windows, with
 a cross-validated count beside the fitted one (:func:`cross_validated`).  The
 confidence model of the chosen candidate is then fitted on the same tuning maps,
-cross-fitted (:func:`calibrated_classifier`, :func:`cross_fitted_features`), and for
-the default classifier on the calibration grid's maps too (:func:`features_under`).
+cross-fitted (:func:`calibrated_classifier`, :func:`cross_fitted_features`), and on
+the calibration grid's maps read the same way (:func:`features_under`).
 
 ``scripts/fit_agreement_gate.py`` fits the ``gated`` preset from the default's q_1: the
 agreement gate (:func:`fit_gate`: the score threshold a = ln tau_1 and the agreement
