@@ -58,6 +58,10 @@ diffusion time, wall following x 2):
   inside the window: paths may
   leave the window in time, so the events at its edges are no longer the ends of cut
   chains, which maxmin otherwise favours as outliers.
+* ``band-B`` -- landmarks drawn (maxmin) only among the nodes of the window's middle
+  B x its length; distances still on the whole window's graph: landmarks that differ in
+  place rather than in time (the metric grows about 0.35 s per second between two
+  events at one place, ``metric_vs_truth.py``).
 * ``smooth-HOW-K`` -- Vietoris-Rips on neighbourhood-averaged landmark distances:
   d~(l_i, l_j) = (A_ij + A_ji) / 2 with A_ij the mean (HOW = ``mean``) or median
   (``median``) of d(l_i, y) over the K nodes y nearest l_j, or that mean minus their
@@ -408,10 +412,19 @@ def _trajectory(log, seed, factor):
         P._map_window = original
 
 
-def _padded(log, seed, factor):
+def _in_band(times: np.ndarray, span: tuple[float, float], band: float) -> np.ndarray:
+    """Whether each time lies in the middle ``band`` share of ``span`` = (t0, t1), ends included."""
+    t0, t1 = span
+    margin = (1 - band) / 2 * (t1 - t0)
+    return (times >= t0 + margin) & (times <= t1 - margin)
+
+
+def _padded(log, seed, factor, band=1.0):
     """Each window's graph built on the window widened by ``factor`` x its length on both
-    sides, landmarks drawn only among the nodes inside the window: paths may leave the
-    window in time, so the events at its edges are not outliers of a cut chain."""
+    sides, landmarks drawn only among the nodes inside the central ``band`` share of the
+    window (``pad-F``: band 1, paths may leave the window in time, so the events at its
+    edges are not outliers of a cut chain; ``band-B``: no padding, landmarks from the
+    window's middle B x its length, so they are spread over space rather than time)."""
     original_build, original_map, original_subsample = P.build_graph, P._map_window, P._subsample
     current = {"span": None}
 
@@ -426,12 +439,9 @@ def _padded(log, seed, factor):
         return original_map(span, sub, n_land, config, rng, timings, say)
 
     def subsample(graph, config, n_landmarks, rng):
-        span = current["span"]
-        if span is None:
-            return original_subsample(graph, config, n_landmarks, rng)
         node_t = np.full(graph.n_nodes, np.inf)
         np.minimum.at(node_t, graph.node_of_event, graph.event_t)
-        inside = (node_t >= span[0]) & (node_t <= span[1])
+        inside = _in_band(node_t, current["span"] or (float(graph.event_t.min()), float(graph.event_t.max())), band)
         arrays = L._GraphArrays.of(graph)
         start = L._random_candidate(inside, np.random.default_rng(rng))
         nodes, radii = L._pick(arrays, inside, n_landmarks, start)
@@ -496,6 +506,8 @@ def _variant(name):
         return lambda log, seed: _windows_of(log, seed, wall_follow_weight=P.wall_follow_option(name.split("-", 1)[1]))
     if name.startswith("pad-"):
         return lambda log, seed: _padded(log, seed, float(name.split("-", 1)[1]))
+    if name.startswith("band-"):
+        return lambda log, seed: _padded(log, seed, 0.0, float(name.split("-", 1)[1]))
     if name.startswith("smooth-"):
         _, how, k = name.split("-")
         return lambda log, seed: _smooth(log, seed, how, int(k))
@@ -605,7 +617,7 @@ def main() -> None:
     parser.add_argument("--per-cell", type=int, default=12)
     parser.add_argument("--variants", nargs="+", default=["default", "20s", "whole", "quarter", "draws", "switch"],
                         help=f"{', '.join(sorted(VARIANTS))}, diffusive-C, switch-C, log-C, wall-C, wall-none, "
-                             "static-F, extra-F, extra-static-F (each [/VARIANT]), smooth-HOW-K, pad-F, paths-C, dtm-K, mds-D, mix-K1-K2[-whole], draws-K[/VARIANT], trace/VARIANT, seed+D, "
+                             "static-F, extra-F, extra-static-F (each [/VARIANT]), smooth-HOW-K, pad-F, band-B, paths-C, dtm-K, mds-D, mix-K1-K2[-whole], draws-K[/VARIANT], trace/VARIANT, seed+D, "
                              "tcorr-S, pool:V1+V2+..., cover-F[/VARIANT] or "
                              "FIELD=VALUE; "
                              "VARIANT@D: with the landmark draw of seed + D")
