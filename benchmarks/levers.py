@@ -58,10 +58,12 @@ diffusion time, wall following x 2):
   inside the window: paths may
   leave the window in time, so the events at its edges are no longer the ends of cut
   chains, which maxmin otherwise favours as outliers.
-* ``band-B`` -- landmarks drawn (maxmin) only among the nodes of the window's middle
-  B x its length; distances still on the whole window's graph: landmarks that differ in
-  place rather than in time (the metric grows about 0.35 s per second between two
-  events at one place, ``metric_vs_truth.py``).
+* ``band-B`` -- ``MapConfig(landmark_bands=(B,))``: landmarks drawn (maxmin) only among
+  the nodes of each window's middle B x its length; distances still on the whole
+  window's graph: landmarks that differ in place rather than in time (the metric grows
+  about 0.35 s per second between two events at one place, ``metric_vs_truth.py``).
+  ``landmark_bands=1,0.5`` maps each window at both in one run, as
+  ``pool:default+band-0.5`` does in two.
 * ``smooth-HOW-K`` -- Vietoris-Rips on neighbourhood-averaged landmark distances:
   d~(l_i, l_j) = (A_ij + A_ji) / 2 with A_ij the mean (HOW = ``mean``) or median
   (``median``) of d(l_i, y) over the K nodes y nearest l_j, or that mean minus their
@@ -223,8 +225,8 @@ def _other_persistence(log, seed, persistence_of):
     window's landmarks and its graph) instead of Vietoris-Rips on the landmarks' metric."""
     original = P._map_window
 
-    def window_with_other_persistence(span, sub, n_land, config, rng, timings, say):
-        window = original(span, sub, n_land, config, rng, timings, say)
+    def window_with_other_persistence(span, sub, n_land, config, rng, timings, say, band=1.0):
+        window = original(span, sub, n_land, config, rng, timings, say, band)
         return dataclasses.replace(window, persistence=persistence_of(window, sub, config.maxdim))
 
     P._map_window = window_with_other_persistence
@@ -394,7 +396,7 @@ def _trajectory(log, seed, factor):
     by default."""
     original = P._map_window
 
-    def window_on_paths(span, sub, n_land, config, rng, timings, say):
+    def window_on_paths(span, sub, n_land, config, rng, timings, say, band=1.0):
         knn_scale = P._knn_scale(sub, config.knn_k)
         dense = _subdivided(sub, factor * knn_scale)
         land = P._subsample(dense, config, min(config.max_landmarks, dense.n_nodes), rng)
@@ -412,19 +414,10 @@ def _trajectory(log, seed, factor):
         P._map_window = original
 
 
-def _in_band(times: np.ndarray, span: tuple[float, float], band: float) -> np.ndarray:
-    """Whether each time lies in the middle ``band`` share of ``span`` = (t0, t1), ends included."""
-    t0, t1 = span
-    margin = (1 - band) / 2 * (t1 - t0)
-    return (times >= t0 + margin) & (times <= t1 - margin)
-
-
-def _padded(log, seed, factor, band=1.0):
+def _padded(log, seed, factor):
     """Each window's graph built on the window widened by ``factor`` x its length on both
-    sides, landmarks drawn only among the nodes inside the central ``band`` share of the
-    window (``pad-F``: band 1, paths may leave the window in time, so the events at its
-    edges are not outliers of a cut chain; ``band-B``: no padding, landmarks from the
-    window's middle B x its length, so they are spread over space rather than time)."""
+    sides, landmarks drawn only among the nodes inside the window: paths may leave the
+    window in time, so the events at its edges are not outliers of a cut chain."""
     original_build, original_map, original_subsample = P.build_graph, P._map_window, P._subsample
     current = {"span": None}
 
@@ -434,18 +427,14 @@ def _padded(log, seed, factor, band=1.0):
             window = (window[0] - pad, window[1] + pad)
         return original_build(log_, metric, window=window, **options)
 
-    def map_window(span, sub, n_land, config, rng, timings, say):
+    def map_window(span, sub, n_land, config, rng, timings, say, band=1.0):
         current["span"] = span
-        return original_map(span, sub, n_land, config, rng, timings, say)
+        return original_map(span, sub, n_land, config, rng, timings, say, band)
 
-    def subsample(graph, config, n_landmarks, rng):
-        node_t = np.full(graph.n_nodes, np.inf)
-        np.minimum.at(node_t, graph.node_of_event, graph.event_t)
-        inside = _in_band(node_t, current["span"] or (float(graph.event_t.min()), float(graph.event_t.max())), band)
-        arrays = L._GraphArrays.of(graph)
-        start = L._random_candidate(inside, np.random.default_rng(rng))
-        nodes, radii = L._pick(arrays, inside, n_landmarks, start)
-        return L._result(arrays, nodes, radii, "maxmin", {"start": start}, L._quiet)
+    def subsample(graph, config, n_landmarks, rng, candidates=None):
+        if current["span"] is None:
+            return original_subsample(graph, config, n_landmarks, rng, candidates)
+        return L.maxmin(graph, n_landmarks, rng=rng, candidates=P.in_band(P.node_times(graph), current["span"], 1.0))
 
     P.build_graph, P._map_window, P._subsample = build, map_window, subsample
     try:
@@ -507,7 +496,7 @@ def _variant(name):
     if name.startswith("pad-"):
         return lambda log, seed: _padded(log, seed, float(name.split("-", 1)[1]))
     if name.startswith("band-"):
-        return lambda log, seed: _padded(log, seed, 0.0, float(name.split("-", 1)[1]))
+        return lambda log, seed: _windows_of(log, seed, landmark_bands=(float(name.split("-", 1)[1]),))
     if name.startswith("smooth-"):
         _, how, k = name.split("-")
         return lambda log, seed: _smooth(log, seed, how, int(k))

@@ -70,7 +70,7 @@ def _truth_maxmin(truth):
     """A stand-in for the pipeline's subsampler: landmarks in maxmin order on the true
     positions of the graph's nodes (their representative events), covering radii in the
     encounter metric (as maxmin's, so the pipeline's covering rule applies unchanged)."""
-    def subsample(graph, config, n_landmarks, rng):
+    def subsample(graph, config, n_landmarks, rng, candidates=None):
         arrays = L._GraphArrays.of(graph)
         positions = event_positions(truth, graph.representative_event())
         start = int(np.random.default_rng(rng).integers(len(positions)))

@@ -292,6 +292,17 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     assert_one_line_error(run("map", simulated[0], "--max-windows", "2"), "at least the number of window scales", code=2)
     assert_one_line_error(run("map", simulated[0], "--paper", "--max-windows", "5"), "--paper fixes --max-windows",
                           code=2)
+    banded = run("map", simulated[0], "--out", tmp_path / "b", "-q", "--window-length", "4", "--landmark-bands", "1,0.5")
+    assert banded.returncode == 0, banded.stderr
+    doc = json.loads((tmp_path / "b" / "map.json").read_text())
+    assert doc["params"]["landmark_bands"] == [1.0, 0.5]
+    assert [w["band"] for w in doc["regions"][0]["windows"]][:2] == [1.0, 0.5]
+    assert_one_line_error(run("map", simulated[0], "--landmark-bands", "1,1.5"), "distinct numbers in (0, 1]", code=2)
+    assert_one_line_error(run("map", simulated[0], "--landmark-bands", "0.5,x"), "comma-separated", code=2)
+    assert_one_line_error(run("map", simulated[0], "--landmark-bands", "0.5", "--subsample", "knn"), "use maxmin",
+                          code=2)
+    assert_one_line_error(run("map", simulated[0], "--paper", "--landmark-bands", "1,0.5"),
+                          "--paper fixes --landmark-bands", code=2)
     assert_one_line_error(run("map", simulated[0], "--window-scales", "1,0"), "distinct positive numbers", code=2)
     assert_one_line_error(run("map", simulated[0], "--window-scales", "1,x"), "comma-separated", code=2)
     assert_one_line_error(run("map", simulated[0], "--paper", "--window-scales", "1,2"),

@@ -126,6 +126,19 @@ def test_maxmin_equals_dense_literal(seed):
 
 
 @pytest.mark.parametrize("seed", [0, 1])
+def test_maxmin_among_candidates_equals_dense_literal(seed):
+    # picks only among the candidates, covering radius over them, distances through every node
+    g = random_geometric_graph(250, seed)
+    candidates = np.random.default_rng(seed).random(len(g.multiplicity)) < 0.4
+    result = maxmin(g, 20, rng=seed, candidates=candidates)
+    assert candidates[result.nodes].all()
+    nodes, radii = literal_farthest_points(dense(g), candidates, 20, result.nodes[0])
+    assert_matches(result, g, nodes, radii)
+    with pytest.raises(InputError, match="candidates"):
+        maxmin(g, 5, rng=seed, candidates=np.zeros(len(g.multiplicity), bool))
+
+
+@pytest.mark.parametrize("seed", [0, 1])
 def test_knn_maxmin_equals_dense_literal(seed):
     g = random_geometric_graph(250, seed)
     result = knn_maxmin(g, 30, k=7, q=0.8, rng=seed)

@@ -90,9 +90,3 @@ def test_a_pool_of_variants_concatenates_their_windows_in_order():
         [[d.lengths(1).tolist() for d in r] for r in expected]
     assert len(regions[0]) == len(first[0][0]) + len(second[0][0])
 
-
-def test_a_band_keeps_the_middle_of_the_window_by_hand():
-    times = np.arange(11.0)
-    assert levers._in_band(times, (0.0, 10.0), 1.0).all()
-    assert np.flatnonzero(levers._in_band(times, (0.0, 10.0), 0.5)).tolist() == [3, 4, 5, 6, 7]  # 2.5 <= t <= 7.5
-    assert np.flatnonzero(levers._in_band(times, (2.0, 6.0), 0.5)).tolist() == [3, 4, 5]

@@ -309,6 +309,35 @@ def test_window_scales_pool_the_windows_of_every_scale():
     assert mixed.to_json()["params"]["window_scales"] == [0.75, 1.0, 1.5]
 
 
+def test_landmark_bands_map_each_window_once_per_band_from_its_middle():
+    log = simulate(default_arena(), 150, 30.0, rng=2).log
+    base = dict(window_encounters=8.0, window_scales=(1.0,), seed=4, **FAST)
+    default = map_encounters(log, MapConfig(**base)).regions[0].windows
+    banded = map_encounters(log, MapConfig(landmark_bands=(1.0, 0.5), **base)).regions[0]
+    windows = banded.windows
+    assert len(default) > 1 and len(windows) == 2 * len(default)
+    assert [(w.t0, w.t1, w.band) for w in windows] == [(w.t0, w.t1, b) for w in default for b in (1.0, 0.5)]
+    for w in windows[1::2]:  # band 0.5: every landmark from the middle half of its window
+        quarter = (w.t1 - w.t0) / 4
+        times = log.t[w.landmark_events]
+        assert (times >= w.t0 + quarter - 1e-9).all() and (times <= w.t1 - quarter + 1e-9).all()
+    assert any(log.t[w.landmark_events].min() < w.t0 + (w.t1 - w.t0) / 4 for w in windows[::2])
+    assert banded.betti[1] == load_classifier("default").pooled_betti([w.diagram for w in windows])[1]
+    assert windows[1].to_json()["band"] == 0.5
+    only = map_encounters(log, MapConfig(landmark_bands=(1.0,), **base)).regions[0].windows
+    assert [w.diagram.lengths(1).tolist() for w in only] == [w.diagram.lengths(1).tolist() for w in default]
+
+
+@pytest.mark.parametrize("bands, subsample, message", [((), "maxmin", "distinct numbers in"),
+                                                       ((1.0, 0.0), "maxmin", "distinct numbers in"),
+                                                       ((1.5,), "maxmin", "distinct numbers in"),
+                                                       ((0.5, 0.5), "maxmin", "distinct numbers in"),
+                                                       ((1.0, 0.5), "knn", "use maxmin")])
+def test_bad_landmark_bands_are_refused(bands, subsample, message):
+    with pytest.raises(SwarmtopoError, match=message):
+        MapConfig(landmark_bands=bands, subsample=subsample).validate()
+
+
 @pytest.mark.parametrize("scales, message", [((), "one or more positive"), ((1.0, 0.0), "one or more positive"),
                                              ((1.0, float("nan")), "one or more positive"),
                                              ((1.0, 1.0), "distinct")])

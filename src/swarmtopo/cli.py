@@ -292,6 +292,19 @@ def _parse_scales(text: Optional[str]):
     return scales
 
 
+def _parse_bands(text: Optional[str]):
+    """A --landmark-bands value: comma-separated distinct numbers in (0, 1]."""
+    if text is None:
+        return None
+    try:
+        bands = tuple(float(x) for x in text.split(","))
+    except ValueError:
+        raise typer.BadParameter(f"{text!r} is not a comma-separated list of numbers (e.g. 1,0.5)") from None
+    if not all(0 < x <= 1 for x in bands) or len(set(bands)) < len(bands):
+        raise typer.BadParameter(f"{text!r}: the bands must be distinct numbers in (0, 1]")
+    return bands
+
+
 def _parse_max_windows(text: Optional[str]):
     """A --max-windows value: 'none' (every window) or a whole number >= 1."""
     if text is None or text.strip().lower() == "none":
@@ -341,6 +354,11 @@ def map_command(
         None, "--window-scales", callback=_parse_scales,
         help="Comma-separated multipliers of the window length: the windows of every such length are pooled "
              "together (default: 0.75,1,1.25; 1 maps one length, about three times faster: docs/accuracy.md)."),
+    landmark_bands: Optional[str] = typer.Option(
+        None, "--landmark-bands", callback=_parse_bands,
+        help="Comma-separated shares of each window's length: every window is mapped once per share B, its "
+             "landmarks drawn from the window's middle B x its length, and all are pooled (default 1: the whole "
+             "window; 1,0.5 is a lever measured on sparse logs, not yet the default: docs/accuracy.md)."),
     max_windows: Optional[str] = typer.Option(
         None, "--max-windows", callback=_parse_max_windows,
         help="Cap of the time windows mapped, all lengths together, at least one per length (default 48, more "
@@ -374,6 +392,7 @@ def map_command(
         given = [name for name, value in (("--hop-cost", hop_cost), ("--diffusion-time", diffusion_time),
                                           ("--wall-follow-weight", wall_follow_weight),
                                           ("--window-length", window_length), ("--window-scales", window_scales),
+                                          ("--landmark-bands", landmark_bands),
                                           ("--max-windows", max_windows), ("--classifier", classifier))
                  if value is not None]
         if given:
@@ -389,6 +408,7 @@ def map_command(
                            wall_follow_weight=wall_follow_option(wall_follow_weight),
                            window_length=seconds_option(window_length),
                            window_scales=window_scales or MapConfig.window_scales,
+                           landmark_bands=landmark_bands or MapConfig.landmark_bands,
                            max_windows=max_windows_option(max_windows), agreement=agreement).validate()
     except SwarmtopoError as exc:  # options that do not go together: a usage error
         raise typer.BadParameter(str(exc)) from None
@@ -712,7 +732,9 @@ def _map_details(tmap) -> None:
                 f"{len(r.cycles)} loop(s) found")
         if len(r.windows) > 1:
             scales = ", ".join(f"{x:g}" for x in tmap.config.window_scales)
-            _detail(f"region {r.component}: {len(r.windows)} windows of {scales} x {tmap.window_length[0]:.3g} s counted "
+            bands = ("" if tmap.config.landmark_bands == (1.0,) else
+                     f" (landmarks from their middle {', '.join(f'{x:g}' for x in tmap.config.landmark_bands)})")
+            _detail(f"region {r.component}: {len(r.windows)} windows of {scales} x {tmap.window_length[0]:.3g} s{bands} counted "
                     f"{[w.betti.get(1) for w in r.windows]} holes each; pooled {r.betti.get(1)}, shown: window "
                     f"{r.window} [{r.windows[r.window].t0:.1f}, {r.windows[r.window].t1:.1f}] s")
     _detail(f"per-hop cost h = {tmap.hop_cost[0]:.3g} s ({tmap.hop_cost[1]}); diffusion time "

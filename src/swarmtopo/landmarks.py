@@ -79,7 +79,8 @@ class Landmarks:
     params: dict[str, Any] = field(default_factory=dict)
 
 
-def maxmin(graph, n_landmarks: int, *, rng=None, progress: Progress | None = None) -> Landmarks:
+def maxmin(graph, n_landmarks: int, *, rng=None, progress: Progress | None = None,
+           candidates: np.ndarray | None = None) -> Landmarks:
     """Maxmin (farthest-point) landmarks: l_k = argmax_x d(x, L).
 
     Parameters
@@ -94,19 +95,28 @@ def maxmin(graph, n_landmarks: int, *, rng=None, progress: Progress | None = Non
     progress
         Called with the name of each stage as it starts (``"picks"``,
         ``"distances"``) and with ``"done"`` at the end.
+    candidates
+        Optional (n_nodes,) bool mask: landmarks are drawn among these nodes only,
+        and the covering radius is over them (distances still through every node).
 
     Returns
     -------
     Landmarks
         ``params``: ``start`` (l_1).  Maxmin property: d(l_i, l_j) >= cover_radii[j-1]
-        for i < j (0-based), and every node is within ``cover_radius`` of L.
+        for i < j (0-based), and every candidate is within ``cover_radius`` of L.
     """
     arrays = _GraphArrays.of(graph)
     n_landmarks = positive_int("n_landmarks", n_landmarks)
     _check_connected(arrays)
     rng = np.random.default_rng(rng)
     notify = progress or _quiet
-    candidates = np.ones(arrays.n, bool)
+    if candidates is None:
+        candidates = np.ones(arrays.n, bool)
+    else:
+        candidates = np.asarray(candidates, bool)
+        if candidates.shape != (arrays.n,) or not candidates.any():
+            raise InputError(f"candidates must be a bool mask of shape ({arrays.n},) with at least one node set, "
+                             f"got shape {candidates.shape} with {int(candidates.sum())} set")
     start = _random_candidate(candidates, rng)
     notify("picks")
     nodes, radii = _pick(arrays, candidates, n_landmarks, start)

@@ -139,6 +139,7 @@ def job_map_config(mapping: dict[str, Any], seed: int | None = None) -> MapConfi
         window_encounters=mapping.get("window_encounters", MapConfig.window_encounters),
         window_scales=tuple(mapping.get("window_scales", MapConfig.window_scales)),
         window_step=seconds_option(mapping.get("window_step")),
+        landmark_bands=tuple(mapping.get("landmark_bands", MapConfig.landmark_bands)),
         landmarks=None if mapping["landmarks"] == "auto" else mapping["landmarks"],
         max_landmarks=mapping.get("max_landmarks", MapConfig.max_landmarks),
         maxdim=mapping["maxdim"], seed=seed, embed_dim=0, cycles=False,

@@ -35,7 +35,7 @@ A_GRID = tuple(np.round(np.arange(1.60, 2.2001, 0.02), 2))
 B_GRID = tuple(np.round(np.arange(0.0, 0.9601, 0.02), 2))
 """The agreement gate's grid: score threshold a = ln tau_1 and agreement threshold b."""
 PIPELINE_FIELDS = ("metric", "hop_cost", "diffusion_time", "wall_follow_weight", "window_length",
-                   "window_encounters", "window_scales", "window_step")
+                   "window_encounters", "window_scales", "window_step", "landmark_bands")
 """The MapConfig fields the candidate pipelines of ``scripts/tune_accuracy.py`` set: the
 chosen candidate's must be MapConfig's defaults."""
 
