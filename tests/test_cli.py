@@ -299,6 +299,7 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     assert [w["band"] for w in doc["regions"][0]["windows"]][:2] == [1.0, 0.5]
     assert_one_line_error(run("map", simulated[0], "--landmark-bands", "1,1.5"), "distinct numbers in (0, 1]", code=2)
     assert_one_line_error(run("map", simulated[0], "--landmark-bands", "0.5,x"), "comma-separated", code=2)
+    assert_one_line_error(run("map", simulated[0], "--landmark-bands", "0.5,0.5"), "must be distinct", code=2)
     assert_one_line_error(run("map", simulated[0], "--landmark-bands", "0.5", "--subsample", "knn"), "use maxmin",
                           code=2)
     assert_one_line_error(run("map", simulated[0], "--paper", "--landmark-bands", "1,0.5"),

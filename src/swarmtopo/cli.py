@@ -279,15 +279,23 @@ def _parse_seconds(text: Optional[str]):
     return text
 
 
+def _distinct_numbers(text: str, example: str) -> tuple[float, ...]:
+    """Comma-separated distinct numbers (a usage error otherwise)."""
+    try:
+        numbers = tuple(float(x) for x in text.split(","))
+    except ValueError:
+        raise typer.BadParameter(f"{text!r} is not a comma-separated list of numbers (e.g. {example})") from None
+    if len(set(numbers)) < len(numbers):
+        raise typer.BadParameter(f"{text!r}: the numbers must be distinct")
+    return numbers
+
+
 def _parse_scales(text: Optional[str]):
     """A --window-scales value: comma-separated distinct positive numbers."""
     if text is None:
         return None
-    try:
-        scales = tuple(float(x) for x in text.split(","))
-    except ValueError:
-        raise typer.BadParameter(f"{text!r} is not a comma-separated list of numbers (e.g. 0.75,1,1.25)") from None
-    if not all(math.isfinite(x) and x > 0 for x in scales) or len(set(scales)) < len(scales):
+    scales = _distinct_numbers(text, "0.75,1,1.25")
+    if not all(math.isfinite(x) and x > 0 for x in scales):
         raise typer.BadParameter(f"{text!r}: the scales must be distinct positive numbers")
     return scales
 
@@ -296,11 +304,8 @@ def _parse_bands(text: Optional[str]):
     """A --landmark-bands value: comma-separated distinct numbers in (0, 1]."""
     if text is None:
         return None
-    try:
-        bands = tuple(float(x) for x in text.split(","))
-    except ValueError:
-        raise typer.BadParameter(f"{text!r} is not a comma-separated list of numbers (e.g. 1,0.5)") from None
-    if not all(0 < x <= 1 for x in bands) or len(set(bands)) < len(bands):
+    bands = _distinct_numbers(text, "1,0.5")
+    if not all(0 < x <= 1 for x in bands):
         raise typer.BadParameter(f"{text!r}: the bands must be distinct numbers in (0, 1]")
     return bands
 
