@@ -738,7 +738,7 @@ def _map_details(tmap) -> None:
         if len(r.windows) > 1:
             scales = ", ".join(f"{x:g}" for x in tmap.config.window_scales)
             bands = ("" if tmap.config.landmark_bands == (1.0,) else
-                     f" (landmarks from their middle {', '.join(f'{x:g}' for x in tmap.config.landmark_bands)})")
+                     f", each at landmark bands {', '.join(f'{x:g}' for x in tmap.config.landmark_bands)}")
             _detail(f"region {r.component}: {len(r.windows)} windows of {scales} x {tmap.window_length[0]:.3g} s{bands} counted "
                     f"{[w.betti.get(1) for w in r.windows]} holes each; pooled {r.betti.get(1)}, shown: window "
                     f"{r.window} [{r.windows[r.window].t0:.1f}, {r.windows[r.window].t1:.1f}] s")
