@@ -26,11 +26,12 @@ metric.  Readings (each an H1 diagram per window, pooled as the shipped classifi
 
 Each reading gets thresholds fitted on its own maps (``experiments.tuning.fit_thresholds``,
 mean pooling) and is printed fitted / 4-fold cross-validated, per cell and per hole
-family, so a reading is compared at its best.  The gap between ``default`` and
-``truth`` bounds what any metric on these events could gain; ``truth-landmarks`` what
-a better landmark draw could add; the noise rows what a metric must reach.
+family, so a reading is compared at its best.  ``truth-landmarks`` is what a perfect
+metric on these events reaches; ``truth`` and ``metric-truth-landmarks`` split the gap
+into the distances and the draw; the time and noise rows say which kind of error costs
+how much.  Defaults: the two cells that miss the per-cell target, 12 cases each.
 
-    python benchmarks/metric_ceiling.py --per-cell 96 --cells "2 holes, 200 x 30" "3 holes, 200 x 30"
+    python benchmarks/metric_ceiling.py --per-cell 96 [--readings metric-truth-landmarks]
 """
 
 from __future__ import annotations
