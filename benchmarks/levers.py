@@ -8,7 +8,7 @@ best.  Printed per variant and per way of pooling the windows (mean scores, as t
 shipped classifier, and the lower median of the windows' counts, as before): fitted
 exact (beta_0, beta_1), the 4-fold cross-validated count (thresholds fitted without
 each quarter), per-cell counts, counts per hole family (the family of a case's holes;
-"no hole" for none) and seconds per map; then the exact count, per-cell counts and
+"no hole" for none) and seconds per map, after a line with the variant's wall time; then the exact count, per-cell counts and
 each cell's counts per hole family when the maps are read by the shipped ``default``
 classifier (as ``swarmtopo map`` reads a
 log with status changes; ``trace/`` variants' maps too, which ``map`` would read with
@@ -434,7 +434,7 @@ def _padded(log, seed, factor):
     def subsample(graph, config, n_landmarks, rng, candidates=None):
         if current["span"] is None:
             return original_subsample(graph, config, n_landmarks, rng, candidates)
-        return L.maxmin(graph, n_landmarks, rng=rng, candidates=P.in_band(P.node_times(graph), current["span"], 1.0))
+        return L.maxmin(graph, n_landmarks, rng=rng, candidates=P.in_band(graph.node_times(), current["span"], 1.0))
 
     P.build_graph, P._map_window, P._subsample = build, map_window, subsample
     try:
@@ -621,8 +621,10 @@ def main() -> None:
           + ", ".join(CELLS[c].name for c in cells))
     for name in args.variants:
         tasks = [(name, c, i) for i in range(args.per_cell) for c in cells]
+        start = time.perf_counter()
         with ProcessPoolExecutor(args.processes) as pool:
             results = list(pool.map(_run, tasks))
+        print(f"{name}: {len(tasks)} maps in {(time.perf_counter() - start) / 60:.1f} min", flush=True)
         maps = [m for m, _, _, _ in results if m is not None]
         family_of = [f for m, _, f, _ in results if m is not None]
         seconds = np.mean([s for _, _, _, s in results])

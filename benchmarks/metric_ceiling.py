@@ -67,6 +67,12 @@ def _h1(distances: np.ndarray):
     return rips_persistence(distances, maxdim=1).diagram
 
 
+def _farthest_points(positions: np.ndarray, count: int, start: int) -> np.ndarray:
+    """Indices of ``count`` of ``positions`` in maxmin (farthest-point, Euclidean) order from ``start``."""
+    chosen = np.asarray(choose_n_farthest_points(points=positions, nb_points=count, starting_point=start))
+    return np.asarray(cKDTree(positions).query(chosen)[1], np.int64)
+
+
 def _truth_maxmin(truth):
     """A stand-in for the pipeline's subsampler: landmarks in maxmin order on the true
     positions of the graph's nodes (their representative events), covering radii in the
@@ -75,9 +81,7 @@ def _truth_maxmin(truth):
         arrays = L._GraphArrays.of(graph)
         positions = event_positions(truth, graph.representative_event())
         start = int(np.random.default_rng(rng).integers(len(positions)))
-        chosen = np.asarray(choose_n_farthest_points(points=positions, nb_points=n_landmarks, starting_point=start))
-        _, nodes = cKDTree(positions).query(chosen)
-        nodes = np.asarray(nodes, np.int64)
+        nodes = _farthest_points(positions, n_landmarks, start)
         search = _kernels.Searcher(arrays.indptr, arrays.indices, arrays.weights)
         to_set, radii = np.full(arrays.n, np.inf), np.empty(len(nodes))
         for i, node in enumerate(nodes):
@@ -108,9 +112,7 @@ def _window_readings(arena, log, truth, window, region_count: int, rng: np.rando
         elif name == "truth-landmarks" and region_count == 1:
             inside = np.flatnonzero((log.t >= window.t0) & (log.t <= window.t1))
             positions = event_positions(truth, inside)
-            chosen = np.asarray(choose_n_farthest_points(points=positions, nb_points=len(events), starting_point=0))
-            _, picked = cKDTree(positions).query(chosen)
-            out[name] = _h1(geodesic_distances(arena, positions[picked]))
+            out[name] = _h1(geodesic_distances(arena, positions[_farthest_points(positions, len(events), 0)]))
         elif name == "truth-landmarks":
             out[name] = _h1(g)
     return out

@@ -270,8 +270,10 @@ def test_graph_invariants(log, metric):
     # nodes are numbered by their earliest event, which is their representative
     rep = graph.representative_event()
     assert (np.diff(rep) > 0).all()
+    times = graph.node_times()
     for node in range(graph.n_nodes):
         assert rep[node] == graph.event_index[graph.node_of_event == node].min()
+        assert times[node] == graph.event_t[graph.node_of_event == node].min()
 
 
 # -- windowing, subgraphs, searches ------------------------------------------------------

@@ -166,8 +166,15 @@ class EncounterGraph:
 
     def representative_event(self) -> np.ndarray:
         """Original-log index of the earliest event of each node, shape ``(n_nodes,)``."""
+        return self.event_index[self._first_events()]
+
+    def node_times(self) -> np.ndarray:
+        """Time of each node: its earliest event's (``event_t`` is non-decreasing), shape ``(n_nodes,)``."""
+        return self.event_t[self._first_events()]
+
+    def _first_events(self) -> np.ndarray:
         _, first = np.unique(self.node_of_event, return_index=True)
-        return self.event_index[first]
+        return first
 
     def components(self) -> tuple[int, np.ndarray]:
         """Connected components: ``(count, label of each node)``."""

@@ -725,7 +725,7 @@ def _map_window(span, sub: EncounterGraph, n_land: int | None, config: MapConfig
     t0 = time.perf_counter()
     knn_scale = _knn_scale(sub, config.knn_k)
     t_lo, t_hi = (float(sub.event_t.min()), float(sub.event_t.max())) if span is None else span
-    candidates = None if band == 1 else in_band(node_times(sub), (t_lo, t_hi), band)
+    candidates = None if band == 1 else in_band(sub.node_times(), (t_lo, t_hi), band)
     if n_land is None:
         land = _subsample(sub, config, min(config.max_landmarks, sub.n_nodes), rng, candidates)
         land = _first_covering(land, AUTO_COVER_FACTOR * knn_scale)
@@ -741,13 +741,6 @@ def _map_window(span, sub: EncounterGraph, n_land: int | None, config: MapConfig
                      landmark_events=sub.representative_event()[land.nodes],
                      scales=RegionScales(knn=knn_scale, cover_radius=float(land.cover_radius)),
                      persistence=persistence, band=float(band))
-
-
-def node_times(graph: EncounterGraph) -> np.ndarray:
-    """The time of each node of ``graph``: its earliest event's."""
-    times = np.full(graph.n_nodes, np.inf)
-    np.minimum.at(times, graph.node_of_event, graph.event_t)
-    return times
 
 
 def in_band(times: np.ndarray, span: tuple[float, float], band: float) -> np.ndarray:

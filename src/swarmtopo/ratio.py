@@ -164,9 +164,16 @@ def confidence_readout(classifier: "RatioClassifier", landmarks: Sequence[int] =
     model = classifier.calibration_["1"]
     ln_l = np.log(np.asarray(landmarks, dtype=float))
     slopes = model["z"] + model.get("z_x_resolution", 0.0) * ln_l
-    at_zero = expit(model["intercept"] + model.get("resolution", 0.0) * ln_l)
+    at_zero = [calibrated_probability(model, {"z": 0.0, "resolution": x, "z_x_resolution": 0.0}) for x in ln_l]
     return "; ".join(f"L = {count}: z's slope {slope:.2f}, P(right | z = 0) {p:.2f}"
                      for count, slope, p in zip(landmarks, slopes, at_zero))
+
+
+def calibrated_probability(model: dict[str, float], features: dict[str, float]) -> float:
+    """P(right) of a fitted calibration ``model`` (intercept and one coefficient per
+    feature it weighs) at ``features``: expit(intercept + sum of coefficient x feature)."""
+    return float(expit(model["intercept"] + sum(coef * features[name] for name, coef in model.items()
+                                                 if name in features)))
 
 
 def confidence_model() -> LogisticRegression:
@@ -449,9 +456,7 @@ class RatioClassifier:
             if model is None:
                 out[n] = None
                 continue
-            features = self.region_features(windows, n, voted)
-            out[n] = float(expit(model["intercept"] + sum(coef * features[name] for name, coef in model.items()
-                                                          if name in features)))
+            out[n] = calibrated_probability(model, self.region_features(windows, n, voted))
         return out
 
     # -- fitting -------------------------------------------------------------------------

@@ -454,7 +454,7 @@ def reproduce_land2(out: Path, *, runs: int | None = None, progress: Progress | 
                       f"{_fmt(agg['q25_snr'])} - {_fmt(agg['q75_snr'])}",
                       "-" if agg["better_than_maxmin"] is None else f"{agg['better_than_maxmin']:.0%}",
                       f"{agg['beta1_is_1']}/{runs}"])
-    times = sim.log.t[graph.representative_event()]
+    times = graph.node_times()
     figures = [_land2_figure(out / "land2.png", first, times, by_method)]
     settings = {**_common_settings(), "arena": "default_arena()", "agents": AGENTS, "duration": DURATION,
                 "metric": "contracted", "cloud_seed": cloud_seed, "landmarks": LAND2_LANDMARKS, "k": KNN_K,
