@@ -13,6 +13,7 @@ from swarmtopo.errors import SwarmtopoError
 from swarmtopo.experiments import accuracy as acc
 from swarmtopo.experiments.grid import canonical_json
 from swarmtopo.experiments.sweep import run_job
+from swarmtopo.pipeline import fitted_landmark_bands
 
 ROOT = Path(__file__).resolve().parent.parent
 DOC = ROOT / "docs" / "accuracy.md"
@@ -212,15 +213,28 @@ def test_contact_trace_keeps_only_the_encounters_and_maps_from_them():
     assert {"r_d", "v_c", "dt", "simulation"} <= set(log.meta) and not {"r_d", "v_c", "v_p", "dt", "simulation",
                                                                        "seed"} & set(trace.meta)
     assert resolve_hop_cost(trace, None)[1].startswith(f"{HOP_GAP_FACTOR:g} x mean time")
-    trace_pipeline = {**acc.PIPELINES["default"], "input": "contact-trace"}
+    trace_pipeline = acc.TRACE_PIPELINE
     (job,) = acc.reporting_jobs(1, pipelines={"trace": trace_pipeline}, cells=acc.CELLS[3:4])
     (default_job,) = acc.reporting_jobs(1, pipelines={"default": acc.PIPELINES["default"]}, cells=acc.CELLS[3:4])
     row, default_row = run_job(job), run_job(default_job)
     assert row["n_events"] == default_row["n_events"] and row["error"] is None  # the same case, simulated alike
     assert row["diagrams"] != default_row["diagrams"]  # mapped with other weights (h from the data, no wall following)
+    # classifier "default" is map's: the trace classifier for a trace, and the bands each was fitted with
+    assert (row["versions"]["classifier"], default_row["versions"]["classifier"]) == ("trace", "default")
+    assert {w["band"] for r in row["diagrams"] for w in r["windows"]} == set(fitted_landmark_bands(load_classifier("trace")))
+    assert {w["band"] for r in default_row["diagrams"] for w in r["windows"]} == set(acc.PIPELINES["default"]["landmark_bands"])
     bogus = acc.reporting_jobs(1, pipelines={"bogus": {**trace_pipeline, "input": "video"}}, cells=acc.CELLS[3:4])
     with pytest.raises(ValueError, match="map input 'video' is not one of"):
         run_job(bogus[0])
+
+
+def test_benchmark_pipelines_map_as_their_classifiers_were_fitted():
+    """The default pipeline's bands are the ones the shipped default classifier was fitted
+    with (what ``map`` uses when none are given); contact traces keep the trace classifier's."""
+    assert fitted_landmark_bands(load_classifier("default")) == tuple(acc.PIPELINES["default"]["landmark_bands"])
+    assert load_classifier("default").provenance_["pipeline"]["landmark_bands"] == acc.PIPELINES["default"]["landmark_bands"]
+    assert "landmark_bands" not in acc.TRACE_PIPELINE and fitted_landmark_bands(load_classifier("trace")) == (1.0,)
+    assert "landmark_bands" not in acc.PIPELINES["paper"] and fitted_landmark_bands(load_classifier("paper-form")) == (1.0,)
 
 
 def test_most_windows_is_the_largest_region_of_the_stored_maps():

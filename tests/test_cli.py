@@ -7,8 +7,9 @@ import sys
 import numpy as np
 import pytest
 
+from swarmtopo.classify import load_classifier
 from swarmtopo.io import read_log, strip_ground_truth
-from swarmtopo.pipeline import MapConfig
+from swarmtopo.pipeline import MapConfig, fitted_landmark_bands
 
 
 def run(*args, cwd=None):
@@ -257,6 +258,7 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     assert doc["params"]["diffusion_time"] == "inf" and doc["params"]["diffusion_time_used"] is None
     assert doc["params"]["window_length_used"] is None and doc["params"]["wall_follow_weight"] is None
     assert doc["classifier"]["classifier"] == "paper" and len(doc["regions"][0]["windows"]) == 1
+    assert doc["params"]["landmark_bands"] == [1.0]
     default = run("map", simulated[0], "--out", tmp_path / "d", "--hop-cost", "1.5", "--window-length", "8",
                   "--diffusion-time", "0.4", "--wall-follow-weight", "1.5")
     assert default.returncode == 0, default.stderr
@@ -271,6 +273,7 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     assert doc["params"]["window_length"] is None and "encounters" in doc["params"]["window_source"]
     assert doc["params"]["wall_follow_weight"] == MapConfig.wall_follow_weight
     assert doc["params"]["window_scales"] == list(MapConfig.window_scales)
+    assert doc["params"]["landmark_bands"] == list(fitted_landmark_bands(load_classifier("default")))  # unset: its own
     scaled = run("map", simulated[0], "--out", tmp_path / "s", "-q", "--window-scales", "0.5,1")
     assert scaled.returncode == 0, scaled.stderr
     assert json.loads((tmp_path / "s" / "map.json").read_text())["params"]["window_scales"] == [0.5, 1.0]
@@ -278,7 +281,9 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     capped = run("map", simulated[0], "--out", tmp_path / "c", "-q", "--window-length", "4", "--max-windows", "3")
     assert capped.returncode == 0, capped.stderr
     doc = json.loads((tmp_path / "c" / "map.json").read_text())
-    assert doc["params"]["max_windows"] == 3 and len(doc["regions"][0]["windows"]) == 3  # one per length
+    spans = {(w["t0"], w["t1"]) for w in doc["regions"][0]["windows"]}
+    assert doc["params"]["max_windows"] == 3 and len(spans) == 3  # one per length, each mapped once per band
+    assert len(doc["regions"][0]["windows"]) == 3 * len(doc["params"]["landmark_bands"])
     inspected = run("map", simulated[0], "--out", tmp_path / "i", "-q", "--window-length", "4", "--agreement", "always")
     assert inspected.returncode == 0, inspected.stderr
     agreement = json.loads((tmp_path / "i" / "map.json").read_text())["regions"][0]["agreement"]

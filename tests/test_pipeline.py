@@ -12,7 +12,7 @@ from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.log import EncounterLog
 from swarmtopo.pipeline import (DIFFUSION_GAP_FACTOR, HOP_GAP_FACTOR, WHOLE_LOG, MapConfig, _share_landmarks,
                                 _scaled_windows, _windows, map_encounters, mean_agent_gap, resolve_diffusion_time, resolve_hop_cost,
-                                resolve_window, shipped_classifier_for)
+                                fitted_landmark_bands, resolve_window, shipped_classifier_for)
 from swarmtopo.ratio import RatioClassifier, RatioThresholds, region_reader
 from swarmtopo.sim import simulate
 
@@ -312,11 +312,11 @@ def test_window_scales_pool_the_windows_of_every_scale():
 def test_landmark_bands_map_each_window_once_per_band_from_its_middle():
     log = simulate(default_arena(), 150, 30.0, rng=2).log
     base = dict(window_encounters=8.0, window_scales=(1.0,), seed=4, **FAST)
-    default = map_encounters(log, MapConfig(**base)).regions[0].windows
+    whole = map_encounters(log, MapConfig(landmark_bands=(1.0,), **base)).regions[0].windows
     banded = map_encounters(log, MapConfig(landmark_bands=(1.0, 0.5), **base)).regions[0]
     windows = banded.windows
-    assert len(default) > 1 and len(windows) == 2 * len(default)
-    assert [(w.t0, w.t1, w.band) for w in windows] == [(w.t0, w.t1, b) for w in default for b in (1.0, 0.5)]
+    assert len(whole) > 1 and len(windows) == 2 * len(whole)
+    assert [(w.t0, w.t1, w.band) for w in windows] == [(w.t0, w.t1, b) for w in whole for b in (1.0, 0.5)]
     for w in windows[1::2]:  # band 0.5: every landmark from the middle half of its window
         quarter = (w.t1 - w.t0) / 4
         times = log.t[w.landmark_events]
@@ -324,8 +324,25 @@ def test_landmark_bands_map_each_window_once_per_band_from_its_middle():
     assert any(log.t[w.landmark_events].min() < w.t0 + (w.t1 - w.t0) / 4 for w in windows[::2])
     assert banded.betti[1] == load_classifier("default").pooled_betti([w.diagram for w in windows])[1]
     assert windows[1].to_json()["band"] == 0.5
-    only = map_encounters(log, MapConfig(landmark_bands=(1.0,), **base)).regions[0].windows
-    assert [w.diagram.lengths(1).tolist() for w in only] == [w.diagram.lengths(1).tolist() for w in default]
+
+
+def test_unset_landmark_bands_are_the_classifiers_own():
+    log = simulate(default_arena(), 150, 30.0, rng=2).log
+    base = dict(window_encounters=8.0, window_scales=(1.0,), seed=4, **FAST)
+    fitted = load_classifier("default")
+    fitted.provenance_ = {**fitted.provenance_, "pipeline": {"landmark_bands": [1.0, 0.5]}}
+    unnamed = load_classifier("default")
+    unnamed.provenance_ = {k: v for k, v in unnamed.provenance_.items() if k != "pipeline"}
+    assert fitted_landmark_bands(fitted) == (1.0, 0.5) and fitted_landmark_bands(unnamed) == (1.0,)
+    explicit = map_encounters(log, MapConfig(landmark_bands=(1.0, 0.5), **base), classifier=fitted)
+    resolved = map_encounters(log, MapConfig(**base), classifier=fitted)
+    assert resolved.config.landmark_bands == (1.0, 0.5) and resolved.to_json()["params"]["landmark_bands"] == [1.0, 0.5]
+    assert [w.diagram.lengths(1).tolist() for w in resolved.regions[0].windows] == \
+        [w.diagram.lengths(1).tolist() for w in explicit.regions[0].windows]
+    assert map_encounters(log, MapConfig(**base), classifier=unnamed).config.landmark_bands == (1.0,)
+    knn = map_encounters(log, MapConfig(subsample="knn", **base), classifier=fitted)
+    assert knn.config.landmark_bands == (1.0,)  # bands need maxmin: another subsampler maps whole windows
+    assert {w.band for w in knn.regions[0].windows} == {1.0}
 
 
 @pytest.mark.parametrize("bands, subsample, message", [((), "maxmin", "distinct numbers in"),

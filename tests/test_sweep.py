@@ -109,6 +109,11 @@ def test_job_map_config_reads_words_and_numbers():
     assert default.window_scales == MapConfig.window_scales and config.window_scales == MapConfig.window_scales
     scaled = job_map_config(expand_grid({"map": {"window_scales": [1.25, 0.75, 1]}}).jobs[0].config["map"])
     assert scaled.window_scales == (0.75, 1.0, 1.25)
+    # landmark bands: absent or "auto" are the classifier's own (resolved by map_encounters), else as given
+    mapping = expand_grid({}).jobs[0].config["map"]
+    assert "landmark_bands" not in mapping and job_map_config(mapping).landmark_bands is None
+    assert job_map_config({**mapping, "landmark_bands": "auto"}).landmark_bands is None
+    assert job_map_config({**mapping, "landmark_bands": [1.0, 0.5]}).landmark_bands == (1.0, 0.5)
 
 
 def test_window_scales_flat_list_is_one_set_and_list_of_lists_a_grid():

@@ -362,8 +362,9 @@ def map_command(
     landmark_bands: Optional[str] = typer.Option(
         None, "--landmark-bands", callback=_parse_bands,
         help="Comma-separated shares of each window's length: every window is mapped once per share B, its "
-             "landmarks drawn from the window's middle B x its length, and all are pooled (default 1: the whole "
-             "window; 1,0.5 is a lever measured on sparse logs, not yet the default: docs/accuracy.md)."),
+             "landmarks drawn from the window's middle B x its length, and all are pooled (1: the whole window "
+             "once; unset: the bands the classifier reading the map was fitted with, 1,0.5 for the default "
+             "classifier and 1 for the others: docs/accuracy.md)."),
     max_windows: Optional[str] = typer.Option(
         None, "--max-windows", callback=_parse_max_windows,
         help="Cap of the time windows mapped, all lengths together, at least one per length (default 48, more "
@@ -403,7 +404,7 @@ def map_command(
         if given:
             raise typer.BadParameter(f"--paper fixes {', '.join(given)}; drop one or the other")
         hop_cost, diffusion_time, wall_follow_weight, window_length, classifier = 0.0, "none", "none", "none", "paper"
-        window_scales = (1.0,)
+        window_scales, landmark_bands = (1.0,), (1.0,)
     out_dir = out_dir or log_dir / "map"
     if out_dir.exists() and not out_dir.is_dir():
         raise SwarmtopoError(f"{out_dir}: --out is a file; give a folder for the map's outputs")

@@ -174,11 +174,13 @@ class MapConfig:
         Shares B of each window's length: every window is mapped once per band, its
         landmarks drawn (maxmin) only among the nodes of the window's middle B x its
         length, distances still on the whole window's graph, and all of them are
-        pooled.  Default (1,): the whole window, once.  (1, 0.5) adds landmarks that
-        differ in place more than in time (the metric grows about 0.35 s per second
-        between two events at one place): on the sparse tuning cells it beat the
-        default on each of three landmark draws, measured but not yet the default
-        (docs/accuracy.md).  Bands below 1 need ``subsample="maxmin"``.
+        pooled.  (1,): the whole window, once.  (1, 0.5) adds landmarks that differ in
+        place more than in time (the metric grows about 0.35 s per second between two
+        events at one place).  Bands below 1 need ``subsample="maxmin"``.  None
+        (default): with maxmin, the bands the classifier that reads the map was fitted
+        with (:func:`fitted_landmark_bands`), whose thresholds are those bands' (the
+        shipped ``default``: (1, 0.5); ``trace``: (1,); docs/accuracy.md); with
+        another subsampler, (1,).
     landmarks
         Number of landmarks L for the whole map, shared between regions in
         proportion to their events.  None (default): per region, the fewest
@@ -223,7 +225,7 @@ class MapConfig:
     window_step: float | None = None
     max_windows: int | None = MAX_WINDOWS
     subsample: str = "maxmin"
-    landmark_bands: tuple[float, ...] = (1.0,)
+    landmark_bands: tuple[float, ...] | None = None
     landmarks: int | None = None
     max_landmarks: int = 400
     window: tuple[float | None, float | None] | None = None
@@ -242,8 +244,9 @@ class MapConfig:
         object.__setattr__(self, "window_scales",
                            tuple(scales) if isinstance(scales, (list, tuple, np.ndarray)) else (scales,))
         bands = self.landmark_bands
-        object.__setattr__(self, "landmark_bands",
-                           tuple(bands) if isinstance(bands, (list, tuple, np.ndarray)) else (bands,))
+        if bands is not None:
+            object.__setattr__(self, "landmark_bands",
+                               tuple(bands) if isinstance(bands, (list, tuple, np.ndarray)) else (bands,))
 
     def validate(self) -> "MapConfig":
         if self.metric not in METRICS:
@@ -274,7 +277,7 @@ class MapConfig:
             raise SwarmtopoError(f"window_scales must be one or more positive numbers, got {list(scales)}")
         if len(set(scales)) < len(scales):
             raise SwarmtopoError(f"window_scales must be distinct, got {list(scales)}")
-        bands = self.landmark_bands
+        bands = (1.0,) if self.landmark_bands is None else self.landmark_bands
         if not bands or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and 0 < x <= 1
                                 for x in bands) or len(set(bands)) < len(bands):
             raise SwarmtopoError(f"landmark_bands must be one or more distinct numbers in (0, 1], got {list(bands)}")
@@ -573,6 +576,9 @@ def map_encounters(
     """
     config = (config or MapConfig()).validate()
     classifier = classifier or load_classifier(shipped_classifier_for(log))
+    if config.landmark_bands is None:
+        config = replace(config, landmark_bands=fitted_landmark_bands(classifier) if config.subsample == "maxmin"
+                         else (1.0,))
     beta0_model = shipped_beta0_model()
     rng = np.random.default_rng(config.seed)
     say = progress or (lambda stage: None)
@@ -769,6 +775,13 @@ def shipped_classifier_for(log: EncounterLog) -> str:
     status changes, or "trace" for a log without any (a contact trace: no wall following
     to weigh), fitted on the same tuning cases read as encounters only."""
     return "default" if len(log.status_t) else "trace"
+
+
+def fitted_landmark_bands(classifier: BettiClassifier | RatioClassifier) -> tuple[float, ...]:
+    """The landmark bands (``MapConfig.landmark_bands``) a classifier was fitted with: its
+    provenance's ``pipeline.landmark_bands``, (1,) when it names none."""
+    pipeline = getattr(classifier, "provenance_", {}).get("pipeline") or {}
+    return tuple(float(b) for b in pipeline.get("landmark_bands", (1.0,)))
 
 
 def resolve_hop_cost(log: EncounterLog, hop_cost: float | None) -> tuple[float, str]:

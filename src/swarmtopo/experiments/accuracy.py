@@ -63,7 +63,7 @@ PIPELINES: dict[str, dict[str, Any]] = {
     "default": {"metric": "hybrid", "hop_cost": "auto", "diffusion_time": "auto",
                 "wall_follow_weight": MapConfig.wall_follow_weight, "window_length": "auto",
                 "window_encounters": MapConfig.window_encounters, "window_scales": list(MapConfig.window_scales),
-                "window_step": "auto", "classifier": "default"},
+                "window_step": "auto", "landmark_bands": [1.0, 0.5], "classifier": "default"},
     "paper": {"metric": "hybrid", "hop_cost": 0.0, "diffusion_time": "none", "wall_follow_weight": "none",
               "window_length": "none", "classifier": "paper-form"},
 }
@@ -202,9 +202,11 @@ def reporting_jobs(per_cell: int = REPORTING_PER_CELL, pipelines=None, cells=CEL
     return _jobs("reporting", per_cell, pipelines or PIPELINES, cells)
 
 
-TRACE_PIPELINE = {**PIPELINES["default"], "input": "contact-trace"}
+TRACE_PIPELINE = {**{k: v for k, v in PIPELINES["default"].items() if k != "landmark_bands"}, "input": "contact-trace"}
 """The default pipeline reading only a case's encounters, as a real contact trace comes
-(``experiments.sweep.contact_trace``: no status changes, no r_d or speeds)."""
+(``experiments.sweep.contact_trace``: no status changes, no r_d or speeds), with the
+whole window's landmarks only: the ``trace`` classifier was fitted so (``map`` reads a
+contact trace with the bands of the classifier it was fitted with)."""
 READING_PIPELINES = {"log": PIPELINES["default"], "contact-trace": TRACE_PIPELINE}
 """The default pipeline per reading of a case (``experiments.sweep.INPUTS``): its log
 folder, or its encounters only."""

@@ -37,8 +37,8 @@ from ..errors import SwarmtopoError
 from ..io import GROUND_TRUTH_META_KEYS, read_arena, read_log, write_log
 from ..log import EncounterLog
 from ..persistence import snr
-from ..pipeline import (MapConfig, agreement_json, map_encounters, seconds_option, software_versions,
-                        wall_follow_option)
+from ..pipeline import (MapConfig, agreement_json, map_encounters, seconds_option, shipped_classifier_for,
+                        software_versions, wall_follow_option)
 from ..sim import simulate
 from .grid import Job, flat_columns
 from .store import JOB_COLUMNS, ResultStore
@@ -129,7 +129,8 @@ def job_map_config(mapping: dict[str, Any], seed: int | None = None) -> MapConfi
     data; "none" -> inf, except a "none" wall-following weight -> None), as sweeps map:
     no picture, no loops; every other option is ``swarmtopo map``'s default, the window
     cap ``max_windows`` included (not a grid key: no map of the accuracy suite reaches it), and
-    ``agreement`` ("auto" unless the table says, as the gate's fitting jobs do)."""
+    ``agreement`` ("auto" unless the table says, as the gate's fitting jobs do) and
+    ``landmark_bands`` (absent or "auto": the bands the job's classifier was fitted with)."""
     return MapConfig(
         metric=mapping["metric"], subsample=mapping["subsample"],
         hop_cost=seconds_option(mapping["hop_cost"]),
@@ -139,11 +140,16 @@ def job_map_config(mapping: dict[str, Any], seed: int | None = None) -> MapConfi
         window_encounters=mapping.get("window_encounters", MapConfig.window_encounters),
         window_scales=tuple(mapping.get("window_scales", MapConfig.window_scales)),
         window_step=seconds_option(mapping.get("window_step")),
-        landmark_bands=tuple(mapping.get("landmark_bands", MapConfig.landmark_bands)),
+        landmark_bands=landmark_bands_option(mapping.get("landmark_bands", "auto")),
         landmarks=None if mapping["landmarks"] == "auto" else mapping["landmarks"],
         max_landmarks=mapping.get("max_landmarks", MapConfig.max_landmarks),
         maxdim=mapping["maxdim"], seed=seed, embed_dim=0, cycles=False,
         agreement=mapping.get("agreement", MapConfig.agreement))
+
+
+def landmark_bands_option(value) -> tuple[float, ...] | None:
+    """A ``[map]`` table's ``landmark_bands``: "auto" -> None (the classifier's own), else the bands."""
+    return None if value == "auto" else tuple(value)
 
 
 def run_job(job: Job) -> dict[str, Any]:
@@ -151,7 +157,8 @@ def run_job(job: Job) -> dict[str, Any]:
 
     Streams (:meth:`Job.stream_seeds`): the arena's holes, the simulation, and the
     map's landmark start.  The map uses no picture (``embed_dim = 0``) and the
-    classifier named in ``config["map"]["classifier"]``, reading the stripped log folder or,
+    classifier named in ``config["map"]["classifier"]`` ("default": the shipped one for the
+    log read, as ``map``'s: ``trace`` for a contact trace), reading the stripped log folder or,
     with ``config["map"]["input"] = "contact-trace"`` (``INPUTS``; set by benchmark code,
     not a grid key), only its encounters; ``snr_h1`` is the paper's SNR
     of the union diagram in dimension 1 given the true beta_1.
@@ -177,10 +184,11 @@ def run_job(job: Job) -> dict[str, Any]:
                        static_time=swarm.get("static_time", 0.0), rng=seeds["simulation"])
         row["t_simulate"] = time.perf_counter() - t0
         row["n_events"], row["n_agents"] = sim.log.n_events, sim.log.n_agents
-        classifier = _classifier(mapping["classifier"], job.file("map.classifier"))
         log = stripped_log(sim.log)
-        tmap = map_encounters(contact_trace(log) if map_input(mapping) == "contact-trace" else log,
-                              job_map_config(mapping, seeds["map"]), classifier=classifier)
+        log = contact_trace(log) if map_input(mapping) == "contact-trace" else log
+        name = shipped_classifier_for(log) if mapping["classifier"] == "default" else mapping["classifier"]
+        tmap = map_encounters(log, job_map_config(mapping, seeds["map"]),
+                              classifier=_classifier(name, job.file("map.classifier")))
     except SwarmtopoError as exc:
         row["error"] = " ".join(str(exc).split())
     else:
