@@ -36,11 +36,12 @@ import numpy as np
 from sklearn.metrics import log_loss
 from sklearn.model_selection import KFold, cross_val_predict
 
+from swarmtopo.classify import load_classifier
 from swarmtopo.experiments.accuracy import CELLS, PLANNING_CELLS, cell_of, reliability
 from swarmtopo.experiments.store import read_jobs
-from swarmtopo.experiments.sweep import INPUTS, job_map_config, map_input
-from swarmtopo.experiments.tuning import (PIPELINE_FIELDS, cross_fitted_features, features_under, fit_thresholds,
-                                         maps_from_rows)
+from swarmtopo.experiments.sweep import INPUTS, map_input
+from swarmtopo.experiments.tuning import (cross_fitted_features, features_under, fit_thresholds, job_pipeline,
+                                         maps_from_rows, pipeline_fields)
 from swarmtopo.pipeline import MapConfig
 from swarmtopo.ratio import CONFIDENCE_FEATURES, confidence_design, confidence_model
 
@@ -58,10 +59,9 @@ def default_maps(store: str, reading: str = "log", split: str = "tuning"):
     """The maps of the pipeline whose options are MapConfig's defaults, reading the whole
     log folder (``reading`` "log") or its contact trace ("contact-trace"), in job order:
     the tuning cases (``split`` "tuning") or the calibration grid ("calibration")."""
-    defaults = MapConfig()
+    defaults = pipeline_fields(MapConfig(), load_classifier("trace" if reading == "contact-trace" else "default"))
     rows = [r for r in read_jobs(store, columns=COLUMNS) if map_input(r["config"]["map"]) == reading
-            and r["sweep"].startswith(f"accuracy-{split}-")
-            and all(getattr(job_map_config(r["config"]["map"]), k) == getattr(defaults, k) for k in PIPELINE_FIELDS)]
+            and r["sweep"].startswith(f"accuracy-{split}-") and job_pipeline(r["config"]["map"]) == defaults]
     cells = PLANNING_CELLS if split == "calibration" else CELLS
     name = partial(cell_of, cells=cells)
     rows.sort(key=lambda r: (r["replicate"], name(r["config"])))

@@ -576,9 +576,7 @@ def map_encounters(
     """
     config = (config or MapConfig()).validate()
     classifier = classifier or load_classifier(shipped_classifier_for(log))
-    if config.landmark_bands is None:
-        config = replace(config, landmark_bands=fitted_landmark_bands(classifier) if config.subsample == "maxmin"
-                         else (1.0,))
+    config = replace(config, landmark_bands=resolve_landmark_bands(config, classifier))
     beta0_model = shipped_beta0_model()
     rng = np.random.default_rng(config.seed)
     say = progress or (lambda stage: None)
@@ -782,6 +780,14 @@ def fitted_landmark_bands(classifier: BettiClassifier | RatioClassifier) -> tupl
     provenance's ``pipeline.landmark_bands``, (1,) when it names none."""
     pipeline = getattr(classifier, "provenance_", {}).get("pipeline") or {}
     return tuple(float(b) for b in pipeline.get("landmark_bands", (1.0,)))
+
+
+def resolve_landmark_bands(config: MapConfig, classifier: BettiClassifier | RatioClassifier) -> tuple[float, ...]:
+    """The landmark bands a map uses: ``config.landmark_bands``, or when unset, with maxmin
+    the bands ``classifier`` was fitted with (:func:`fitted_landmark_bands`), else (1,)."""
+    if config.landmark_bands is not None:
+        return config.landmark_bands
+    return fitted_landmark_bands(classifier) if config.subsample == "maxmin" else (1.0,)
 
 
 def resolve_hop_cost(log: EncounterLog, hop_cost: float | None) -> tuple[float, str]:

@@ -26,7 +26,10 @@ from scipy.ndimage import uniform_filter, uniform_filter1d
 
 from ..persistence import Diagram
 from ..agreement import BARS, agreement_array
+from ..classify import load_classifier
+from ..pipeline import MapConfig, resolve_landmark_bands
 from ..ratio import CONFIDENCE_FEATURES, RatioClassifier, RatioThresholds, pooled_scores, region_reader, window_scores
+from .sweep import job_map_config, map_input
 
 Q_GRID = (0.5, 0.6, 0.7, 0.8, 0.9)
 TAU_GRID = tuple(np.round(np.geomspace(1.2, 12.0, 80), 4))
@@ -38,6 +41,21 @@ PIPELINE_FIELDS = ("metric", "hop_cost", "diffusion_time", "wall_follow_weight",
                    "window_encounters", "window_scales", "window_step", "landmark_bands")
 """The MapConfig fields the candidate pipelines of ``scripts/tune_accuracy.py`` set: the
 chosen candidate's must be MapConfig's defaults."""
+
+
+def job_pipeline(mapping: dict) -> dict:
+    """The ``PIPELINE_FIELDS`` a stored job was mapped with (its ``[map]`` table; unset
+    landmark bands resolved by the preset classifier that ran it, as ``run_job`` does)."""
+    name = mapping["classifier"]
+    if name == "default" and map_input(mapping) == "contact-trace":
+        name = "trace"
+    return pipeline_fields(job_map_config(mapping), load_classifier(name))
+
+
+def pipeline_fields(config: MapConfig, classifier) -> dict:
+    """``PIPELINE_FIELDS`` of ``config`` as mapped with ``classifier`` (unset bands resolved)."""
+    return {k: resolve_landmark_bands(config, classifier) if k == "landmark_bands" else getattr(config, k)
+            for k in PIPELINE_FIELDS}
 
 
 @dataclass(frozen=True)
