@@ -416,10 +416,11 @@ def _trajectory(log, seed, factor):
 
 def _padded(log, seed, factor):
     """Each window's graph built on the window widened by ``factor`` x its length on both
-    sides, landmarks drawn only among the nodes inside the window: paths may leave the
+    sides, landmarks drawn only among the nodes inside the window (inside its landmark
+    band, with bands): paths may leave the
     window in time, so the events at its edges are not outliers of a cut chain."""
     original_build, original_map, original_subsample = P.build_graph, P._map_window, P._subsample
-    current = {"span": None}
+    current = {"span": None, "band": 1.0}
 
     def build(log_, metric, *, window=None, **options):
         if window is not None:
@@ -428,13 +429,14 @@ def _padded(log, seed, factor):
         return original_build(log_, metric, window=window, **options)
 
     def map_window(span, sub, n_land, config, rng, timings, say, band=1.0):
-        current["span"] = span
+        current["span"], current["band"] = span, band
         return original_map(span, sub, n_land, config, rng, timings, say, band)
 
     def subsample(graph, config, n_landmarks, rng, candidates=None):
         if current["span"] is None:
             return original_subsample(graph, config, n_landmarks, rng, candidates)
-        return L.maxmin(graph, n_landmarks, rng=rng, candidates=P.in_band(graph.node_times(), current["span"], 1.0))
+        return L.maxmin(graph, n_landmarks, rng=rng,
+                        candidates=P.in_band(graph.node_times(), current["span"], current["band"]))
 
     P.build_graph, P._map_window, P._subsample = build, map_window, subsample
     try:

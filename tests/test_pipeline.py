@@ -16,7 +16,8 @@ from swarmtopo.pipeline import (DIFFUSION_GAP_FACTOR, HOP_GAP_FACTOR, WHOLE_LOG,
 from swarmtopo.ratio import RatioClassifier, RatioThresholds, region_reader
 from swarmtopo.sim import simulate
 
-FAST = dict(embed_dim=0)
+FAST = dict(embed_dim=0, landmark_bands=(1.0,))
+"""No picture, whole-window landmarks: the window mechanics tested here; the bands have tests of their own."""
 
 
 def ring_log(n_agents=120, jitter=0.05, rng=0):
@@ -53,14 +54,14 @@ def test_two_disjoint_rooms_give_two_regions():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("arena, holes, recorded", [(default_arena(), 1, 8), (square_arena(), 0, 8)],
+@pytest.mark.parametrize("arena, holes, recorded", [(default_arena(), 1, 7), (square_arena(), 0, 8)],
                          ids=["one-hole", "no-hole"])
 def test_simulated_arenas_map_to_their_hole_count(arena, holes, recorded):
     """The paper's Fig. "encmds" set-up (200 agents, 20 s), default map options, seeds 0-9.
 
     A regression guard at the level recorded with the shipped classifier: one-hole
-    8/10, no-hole 8/10 (18/20 and 16/20 over seeds 0-19 in
-    ``benchmarks/demo_accuracy.py``).  20 s is shorter than an automatic window of
+    7/10, no-hole 8/10 (17/20 and 16/20 over seeds 0-19 in
+    ``benchmarks/demo_accuracy.py``; one-hole 8/10 and 18/20 before the landmark bands).  20 s is shorter than an automatic window of
     scale 1 (scales 1 and 1.25 map the log whole, 0.75 in two windows), and below the
     accuracy benchmark's smallest budget (docs/accuracy.md).
     beta_0 must always be 1.  The seeds are fixed, so the test is deterministic.
@@ -68,7 +69,7 @@ def test_simulated_arenas_map_to_their_hole_count(arena, holes, recorded):
     right = 0
     for seed in range(10):
         sim = simulate(arena, 200, 20.0, rng=seed)
-        tmap = map_encounters(sim.log, MapConfig(seed=seed, **FAST))
+        tmap = map_encounters(sim.log, MapConfig(seed=seed, embed_dim=0))
         assert tmap.betti[0] == 1
         right += tmap.betti[1] == holes
     assert right >= recorded
@@ -311,7 +312,7 @@ def test_window_scales_pool_the_windows_of_every_scale():
 
 def test_landmark_bands_map_each_window_once_per_band_from_its_middle():
     log = simulate(default_arena(), 150, 30.0, rng=2).log
-    base = dict(window_encounters=8.0, window_scales=(1.0,), seed=4, **FAST)
+    base = dict(window_encounters=8.0, window_scales=(1.0,), seed=4, embed_dim=0)
     whole = map_encounters(log, MapConfig(landmark_bands=(1.0,), **base)).regions[0].windows
     banded = map_encounters(log, MapConfig(landmark_bands=(1.0, 0.5), **base)).regions[0]
     windows = banded.windows
@@ -328,7 +329,7 @@ def test_landmark_bands_map_each_window_once_per_band_from_its_middle():
 
 def test_unset_landmark_bands_are_the_classifiers_own():
     log = simulate(default_arena(), 150, 30.0, rng=2).log
-    base = dict(window_encounters=8.0, window_scales=(1.0,), seed=4, **FAST)
+    base = dict(window_encounters=8.0, window_scales=(1.0,), seed=4, embed_dim=0)
     fitted = load_classifier("default")
     fitted.provenance_ = {**fitted.provenance_, "pipeline": {"landmark_bands": [1.0, 0.5]}}
     unnamed = load_classifier("default")

@@ -10,7 +10,7 @@ from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.persistence import Diagram
 from scipy.special import expit
 
-from swarmtopo.pipeline import MapConfig
+from swarmtopo.pipeline import MapConfig, fitted_landmark_bands
 from swarmtopo.ratio import (LOG_RATIO_CAP, MAX_MARGIN, RESOLUTION_CAP, SCORE_VAR_PRIOR, Z_CAP, RatioClassifier,
                              RatioThresholds, below_full_resolution, confidence_readout, longest_bars, median_vote, pooled_scores, region_reader, resolution,
                              score_matrix, score_margin, standardised_margin, vote, window_scores)
@@ -276,8 +276,9 @@ def test_shipped_default_is_a_calibrated_mean_pooled_ratio_classifier_and_gated_
     assert not model.gated and not load_classifier("trace").gated  # the score alone
     gated = load_classifier("gated")
     assert gated.gated and 0 < gated.thresholds_[1].agreement < 1 and set(gated.calibration_) == {"1"}
-    assert gated.thresholds_[1].q == model.thresholds_[1].q  # fitted from the default's q_1 and tau_1
-    assert gated.provenance_["score_only"] == model.thresholds_[1].to_json()
+    # fitted from the previous default's q_1 and tau_1 on its whole-window maps, which it reads with
+    assert gated.thresholds_[1].q == gated.provenance_["score_only"]["q"]
+    assert fitted_landmark_bands(gated) == (1.0,) and "landmark_bands" not in gated.provenance_["pipeline"]
 
 
 @pytest.mark.parametrize("name", ["default", "trace"])

@@ -192,8 +192,8 @@ def test_encimpr_compares_the_three_metrics_on_the_right_logs(tmp_path, monkeypa
     short = next(r for r in rows if r["metric"] == "plain" and float(r["duration"]) == 20.0)
     sim = simulate(default_arena(), rp.AGENTS, 30.0, rng=int(short["seed"]))
     tmap = map_encounters(sim.log, MapConfig(metric="plain", hop_cost=0.0, diffusion_time=WHOLE_LOG,
-                                             wall_follow_weight=None, window_length=WHOLE_LOG, embed_dim=0,
-                                             window=(None, 20.0)))
+                                             wall_follow_weight=None, window_length=WHOLE_LOG, landmark_bands=(1.0,),
+                                             embed_dim=0, window=(None, 20.0)))
     assert int(short["events"]) == tmap.n_events == np.count_nonzero(sim.log.t <= 20.0)
     assert number(short["longest_h1"]) == tmap.diagram.lengths(1)[0]
     for key, agg in result.summary["conditions"].items():

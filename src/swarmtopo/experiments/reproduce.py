@@ -525,7 +525,8 @@ def _runs(name: str, runs: int | None) -> int:
 def _config(metric: str, *, picture: bool, window=None) -> MapConfig:
     """The paper's pipeline with one of its metrics."""
     return MapConfig(metric=metric, hop_cost=0.0, diffusion_time=WHOLE_LOG, wall_follow_weight=None,
-                     window_length=WHOLE_LOG, embed_dim=3 if picture else 0, window=window, cycles=False)
+                     window_length=WHOLE_LOG, landmark_bands=(1.0,), embed_dim=3 if picture else 0, window=window,
+                     cycles=False)
 
 
 def _map(log, config: MapConfig) -> tuple[TopologicalMap | None, str]:
@@ -583,7 +584,7 @@ def _picked(picture: tuple, rows) -> dict[str, Any]:
 def _common_settings() -> dict[str, Any]:
     return {"motion": "MotionParams() (paper defaults)", "r_d": 30.0, "dt": 0.1,
             "map_config": "MapConfig(metric=..., hop_cost=0, diffusion_time=WHOLE_LOG, wall_follow_weight=None, "
-                          "window_length=WHOLE_LOG, embed_dim=3 for pictures else 0), "
+                          "window_length=WHOLE_LOG, landmark_bands=(1,), embed_dim=3 for pictures else 0), "
                           "other fields default",
             "seeds": "run_seed(NAME, i) = SeedSequence([crc32(NAME), i]).generate_state(1)[0]",
             "classifier": load_classifier(PAPER_CLASSIFIER).describe(), "software": software_versions()}
