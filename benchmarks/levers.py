@@ -225,8 +225,8 @@ def _other_persistence(log, seed, persistence_of):
     window's landmarks and its graph) instead of Vietoris-Rips on the landmarks' metric."""
     original = P._map_window
 
-    def window_with_other_persistence(span, sub, n_land, config, rng, timings, say, band=1.0):
-        window = original(span, sub, n_land, config, rng, timings, say, band)
+    def window_with_other_persistence(span, sub, knn_scale, n_land, config, rng, timings, say, band=1.0):
+        window = original(span, sub, knn_scale, n_land, config, rng, timings, say, band)
         return dataclasses.replace(window, persistence=persistence_of(window, sub, config.maxdim))
 
     P._map_window = window_with_other_persistence
@@ -396,8 +396,7 @@ def _trajectory(log, seed, factor):
     by default."""
     original = P._map_window
 
-    def window_on_paths(span, sub, n_land, config, rng, timings, say, band=1.0):
-        knn_scale = P._knn_scale(sub, config.knn_k)
+    def window_on_paths(span, sub, knn_scale, n_land, config, rng, timings, say, band=1.0):
         dense = _subdivided(sub, factor * knn_scale)
         land = P._subsample(dense, config, min(config.max_landmarks, dense.n_nodes), rng)
         land = P._first_covering(land, P.AUTO_COVER_FACTOR * knn_scale)
@@ -428,9 +427,9 @@ def _padded(log, seed, factor):
             window = (window[0] - pad, window[1] + pad)
         return original_build(log_, metric, window=window, **options)
 
-    def map_window(span, sub, n_land, config, rng, timings, say, band=1.0):
+    def map_window(span, sub, knn_scale, n_land, config, rng, timings, say, band=1.0):
         current["span"], current["band"] = span, band
-        return original_map(span, sub, n_land, config, rng, timings, say, band)
+        return original_map(span, sub, knn_scale, n_land, config, rng, timings, say, band)
 
     def subsample(graph, config, n_landmarks, rng, candidates=None):
         if current["span"] is None:

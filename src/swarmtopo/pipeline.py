@@ -617,13 +617,15 @@ def map_encounters(
         for span, wgraph, wlabels in window_graphs:
             part = _region_part(wgraph, wlabels, region_events, log, config)
             if part is not None:
+                knn_scale = _timed_knn_scale(part, config, timings)  # one per window, whatever its bands
                 for band in config.landmark_bands:
-                    windows.append(_map_window(span, part, n_land, config, rng, timings, say, band))
+                    windows.append(_map_window(span, part, knn_scale, n_land, config, rng, timings, say, band))
                     parts.append(part if keep_graphs else None)
         fallback = []
         if not windows:  # no window holds enough of this region: map its whole log instead
             whole = graph.subgraph(np.flatnonzero(labels == comp))
-            windows = [_map_window(None, whole, n_land, config, rng, timings, say, band)
+            knn_scale = _timed_knn_scale(whole, config, timings)
+            windows = [_map_window(None, whole, knn_scale, n_land, config, rng, timings, say, band)
                        for band in config.landmark_bands]
             parts = [whole] * len(windows)
             if lengths_tried:
@@ -721,13 +723,21 @@ def map_encounters(
     )
 
 
-def _map_window(span, sub: EncounterGraph, n_land: int | None, config: MapConfig, rng,
-                timings: dict[str, float], say, band: float = 1.0) -> WindowMap:
-    """Landmarks and persistence of one region's events in one time window (span None: all),
-    the landmarks drawn among the nodes of the window's middle ``band`` share."""
-    say("landmarks")
+def _timed_knn_scale(sub: EncounterGraph, config: MapConfig, timings: dict[str, float]) -> float:
+    """The window's k-NN scale s (:func:`_knn_scale`), its time counted in the landmarks stage."""
     t0 = time.perf_counter()
     knn_scale = _knn_scale(sub, config.knn_k)
+    timings["landmarks"] += time.perf_counter() - t0
+    return knn_scale
+
+
+def _map_window(span, sub: EncounterGraph, knn_scale: float, n_land: int | None, config: MapConfig, rng,
+                timings: dict[str, float], say, band: float = 1.0) -> WindowMap:
+    """Landmarks and persistence of one region's events in one time window (span None: all),
+    the landmarks drawn among the nodes of the window's middle ``band`` share; ``knn_scale``
+    is the window's s (:func:`_timed_knn_scale`, shared by its bands)."""
+    say("landmarks")
+    t0 = time.perf_counter()
     t_lo, t_hi = (float(sub.event_t.min()), float(sub.event_t.max())) if span is None else span
     candidates = None if band == 1 else in_band(sub.node_times(), (t_lo, t_hi), band)
     if n_land is None:

@@ -37,8 +37,8 @@ from ..errors import SwarmtopoError
 from ..io import GROUND_TRUTH_META_KEYS, read_arena, read_log, write_log
 from ..log import EncounterLog
 from ..persistence import snr
-from ..pipeline import (MapConfig, agreement_json, map_encounters, seconds_option, shipped_classifier_for,
-                        software_versions, wall_follow_option)
+from ..pipeline import (MapConfig, agreement_json, map_encounters, seconds_option, software_versions,
+                        wall_follow_option)
 from ..sim import simulate
 from .grid import Job, flat_columns
 from .store import JOB_COLUMNS, ResultStore
@@ -147,6 +147,14 @@ def job_map_config(mapping: dict[str, Any], seed: int | None = None) -> MapConfi
         agreement=mapping.get("agreement", MapConfig.agreement))
 
 
+def job_classifier(mapping: dict[str, Any]) -> str:
+    """The classifier a job's map is read with: its ``[map]`` table's, "default" being
+    ``map``'s own for what the job reads (:func:`~swarmtopo.pipeline.shipped_classifier_for`:
+    ``trace`` for a contact trace; a simulated log always has status rows)."""
+    name = mapping["classifier"]
+    return "trace" if name == "default" and map_input(mapping) == "contact-trace" else name
+
+
 def landmark_bands_option(value) -> tuple[float, ...] | None:
     """A ``[map]`` table's ``landmark_bands``: "auto" -> None (the classifier's own), else the bands."""
     return None if value == "auto" else tuple(value)
@@ -185,10 +193,9 @@ def run_job(job: Job) -> dict[str, Any]:
         row["t_simulate"] = time.perf_counter() - t0
         row["n_events"], row["n_agents"] = sim.log.n_events, sim.log.n_agents
         log = stripped_log(sim.log)
-        log = contact_trace(log) if map_input(mapping) == "contact-trace" else log
-        name = shipped_classifier_for(log) if mapping["classifier"] == "default" else mapping["classifier"]
-        tmap = map_encounters(log, job_map_config(mapping, seeds["map"]),
-                              classifier=_classifier(name, job.file("map.classifier")))
+        tmap = map_encounters(contact_trace(log) if map_input(mapping) == "contact-trace" else log,
+                              job_map_config(mapping, seeds["map"]),
+                              classifier=_classifier(job_classifier(mapping), job.file("map.classifier")))
     except SwarmtopoError as exc:
         row["error"] = " ".join(str(exc).split())
     else:
