@@ -139,6 +139,39 @@ def test_maxmin_among_candidates_equals_dense_literal(seed):
 
 
 @pytest.mark.parametrize("seed", [0, 1])
+def test_maxmin_in_a_band_equals_dense_literal(seed):
+    # candidates in a strip, as a landmark band is the middle of a window: the searches
+    # stop at the covering radius, most of the graph outside the strip is never settled
+    # again, and the picks and radii are still those of the full distance matrix
+    g = random_geometric_graph(400, seed, radius=0.1)
+    x = np.linalg.eigh(dense(g))[1][:, -2]  # any coordinate along the graph will do
+    candidates = np.abs(x - np.median(x)) <= np.quantile(np.abs(x - np.median(x)), 0.3)
+    result = maxmin(g, 30, rng=seed, candidates=candidates)
+    nodes, radii = literal_farthest_points(dense(g), candidates, 30, result.nodes[0])
+    assert_matches(result, g, nodes, radii)
+
+
+def test_lower_distances_is_exact_up_to_its_limit():
+    # the invariant of _kernels.lower_distances: after each landmark with limit r,
+    # to_set = d(x, L) where d(x, L) <= r, and to_set >= d(x, L) elsewhere
+    from swarmtopo._kernels import Searcher
+    g = random_geometric_graph(300, 3, radius=0.12)
+    d = dense(g)
+    a = g.adjacency
+    search = Searcher(a.indptr.astype(np.int64), a.indices.astype(np.int64), a.data.astype(float))
+    to_set = np.full(len(d), np.inf)
+    order = np.random.default_rng(3).permutation(len(d))[:25]
+    limits = np.r_[np.inf, np.linspace(d.max(), d.max() / 10, 24)]
+    for i, (node, limit) in enumerate(zip(order, limits)):
+        search.add_landmark(int(node), to_set, limit)
+        exact = d[order[: i + 1]].min(axis=0)
+        within = exact <= limit
+        np.testing.assert_allclose(to_set[within], exact[within], rtol=RTOL)
+        assert (to_set[~within] >= exact[~within] * (1 - RTOL)).all()
+    assert (~within).any() and (to_set[~within] > exact[~within] * (1 + RTOL)).any()  # the limit cut something
+
+
+@pytest.mark.parametrize("seed", [0, 1])
 def test_knn_maxmin_equals_dense_literal(seed):
     g = random_geometric_graph(250, seed)
     result = knn_maxmin(g, 30, k=7, q=0.8, rng=seed)

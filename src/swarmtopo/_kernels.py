@@ -133,15 +133,22 @@ def settle(indptr, indices, weights, source, count, stop_count,
 
 
 @njit(cache=True)
-def lower_distances(indptr, indices, weights, source, to_set, dist, touched, heap_keys, heap_nodes):
-    """Lower ``to_set[x]`` to d(source, x) wherever that is smaller, in place.
+def lower_distances(indptr, indices, weights, source, to_set, dist, touched, heap_keys, heap_nodes, limit):
+    """Lower ``to_set[x]`` to d(source, x) wherever that is smaller and at most ``limit``, in place.
 
     ``to_set`` holds d(x, L) for a landmark set L; ``source`` joins L.  The search
     expands a node v only while d(source, v) < to_set[v]: past such a v nothing can
     improve, since d(source, x) = d(source, v) + d(v, x) >= d(v, L) + d(v, x) >= d(x, L)
     (triangle inequality).  So it is exact and touches only the new landmark's
     Voronoi cell -- on hub-heavy graphs (static agents) a few nodes instead of most
-    of the graph.  Scratch arrays as in :func:`settle`.  Returns the nodes settled.
+    of the graph.  It stops at distances above ``limit`` (+inf: none).
+
+    With a finite ``limit`` the argument holds on a weaker invariant: ``to_set[x]`` =
+    d(x, L) wherever d(x, L) <= ``limit``, and ``to_set[x]`` >= d(x, L) elsewhere.  A
+    node on a shortest path from ``source`` to a node it improves within ``limit`` is
+    itself improved within ``limit``, so it is never cut off; the invariant holds
+    after the call with ``limit`` (or any smaller bound) for L + {source}.  Scratch
+    arrays as in :func:`settle`.  Returns the nodes settled.
     """
     dist[source] = 0.0
     touched[0] = source
@@ -152,6 +159,8 @@ def lower_distances(indptr, indices, weights, source, to_set, dist, touched, hea
         d = heap_keys[0]
         u = heap_nodes[0]
         size = _heap_pop(heap_keys, heap_nodes, size)
+        if d > limit:
+            break  # every entry left is farther
         if d > dist[u]:
             continue
         to_set[u] = d
@@ -173,10 +182,10 @@ class Searcher:
         self.heap_keys = np.empty(len(weights) + 1)
         self.heap_nodes = np.empty(len(weights) + 1, np.int64)
 
-    def add_landmark(self, source: int, to_set: np.ndarray) -> int:
-        """Lower ``to_set`` (d(x, L), all nodes) for L + {source}; see :func:`lower_distances`."""
+    def add_landmark(self, source: int, to_set: np.ndarray, limit: float = np.inf) -> int:
+        """Lower ``to_set`` (d(x, L)) for L + {source} up to ``limit``; see :func:`lower_distances`."""
         return lower_distances(self.indptr, self.indices, self.weights, source, to_set, self.dist,
-                               self.touched, self.heap_keys, self.heap_nodes)
+                               self.touched, self.heap_keys, self.heap_nodes, float(limit))
 
 
 @njit(cache=True, parallel=True)

@@ -328,8 +328,10 @@ def _pick(arrays: _GraphArrays, candidates: np.ndarray, n_landmarks: int, start:
           bonus: Callable[[float], np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Sequential landmark picks.
 
-    ``to_set`` holds d(x, L) for every node; each new landmark lowers it with a search
-    that stops where it cannot improve (exact; see :func:`_kernels.lower_distances`).
+    ``to_set`` holds d(x, L); each new landmark lowers it with a search that stops
+    where it cannot improve and beyond the covering radius r before the pick (exact
+    wherever d(x, L) <= r, so on every candidate; see :func:`_kernels.lower_distances`:
+    with candidates in a band of a window the searches stay out of the rest of it).
     ``u`` is d(x, L) on the candidates and -inf elsewhere, so non-candidates never win
     an argmax nor count in the covering radius r = max u.  The next landmark is argmax
     u (maxmin) or argmax u + bonus(r) over non-landmarks.  Returns the landmark nodes
@@ -342,10 +344,11 @@ def _pick(arrays: _GraphArrays, candidates: np.ndarray, n_landmarks: int, start:
     nodes = np.empty(n_landmarks, np.int64)
     radii = np.empty(n_landmarks)
     landmark = start
+    radius = np.inf  # before the first pick nothing is covered
     for i in range(n_landmarks):
         nodes[i] = landmark
         is_landmark[landmark] = True
-        search.add_landmark(landmark, to_set)
+        search.add_landmark(landmark, to_set, radius)
         u = np.where(candidates, to_set, -np.inf)
         radius = radii[i] = u.max()
         if i + 1 == n_landmarks:
