@@ -398,8 +398,8 @@ def _trajectory(log, seed, factor):
 
     def window_on_paths(span, sub, knn_scale, n_land, config, rng, timings, say, band=1.0):
         dense = _subdivided(sub, factor * knn_scale)
-        land = P._subsample(dense, config, min(config.max_landmarks, dense.n_nodes), rng)
-        land = P._first_covering(land, P.AUTO_COVER_FACTOR * knn_scale)
+        land = P._subsample(dense, config, min(config.max_landmarks, dense.n_nodes), rng,
+                            cover=P.AUTO_COVER_FACTOR * knn_scale)
         persistence = rips_persistence(land.distances, maxdim=config.maxdim)
         return P.WindowMap(t0=0.0, t1=0.0, n_events=sub.n_events, landmarks=land,
                            landmark_events=np.zeros(len(land.nodes), np.int64),

@@ -129,6 +129,24 @@ def test_table_and_reliability_hand_computed():
     assert rel["brier"] == pytest.approx(0.01) and rel["brier_constant"] == pytest.approx(0.1875)
     assert [(b["maps"], b["fraction_right"]) for b in rel["bins"]] == [(1, 0.0), (3, 1.0)]
     assert [(b["low"], b["high"]) for b in rel["bins"]] == [(0.0, 0.5), (0.9, 0.95)]  # narrow bins near 1
+    lo, hi = rel["brier_gain95"]
+    assert lo <= 0.1875 - 0.01 <= hi
+
+
+def test_brier_gain_interval_separates_a_sharp_confidence_from_the_constant():
+    y = np.r_[np.ones(190), np.zeros(10)]
+    # a confidence that knows which maps are wrong beats the constant in every resample
+    lo, hi = acc.brier_gain_interval(np.where(y == 1, 0.95, 0.3), y)
+    assert 0 < lo < hi
+    # the constant itself: each resample's own rate is at least as good, so the gain is <= 0
+    lo, hi = acc.brier_gain_interval(np.full(200, y.mean()), y)
+    assert lo < 0 and hi <= 1e-15
+    assert acc.brier_gain_interval(np.array([0.9]), np.array([1.0])) is None  # one map: no interval
+    # per resample: the gain of a literal loop over the same resampled indices
+    p = np.random.default_rng(1).uniform(0.5, 1, 200)
+    rows = np.random.default_rng(2).integers(0, 200, (5, 200))
+    literal = [np.mean((y[r].mean() - y[r]) ** 2) - np.mean((p[r] - y[r]) ** 2) for r in rows]
+    np.testing.assert_allclose(acc.brier_gain(p[rows], y[rows]), literal)
 
 
 def recorded_slice() -> tuple[int, int]:

@@ -151,6 +151,23 @@ def test_maxmin_in_a_band_equals_dense_literal(seed):
     assert_matches(result, g, nodes, radii)
 
 
+@pytest.mark.parametrize("subsample", SUBSAMPLERS)
+@pytest.mark.parametrize("quantile", [0.0, 0.3, 0.9])
+def test_cover_stops_the_run_at_its_first_covering_prefix(subsample, quantile):
+    # with cover c, the run is the full run's first n picks, n = the first pick with
+    # radius <= c (at least 3): same nodes, radii and distances
+    g = random_geometric_graph(300, 5)
+    full = SUBSAMPLERS[subsample](g, 60, rng=5)
+    cover = float(np.quantile(full.cover_radii, quantile))
+    within = np.flatnonzero(full.cover_radii <= cover)
+    n = max(int(within[0]) + 1, 3)
+    stopped = SUBSAMPLERS[subsample](g, 60, rng=5, cover=cover)
+    np.testing.assert_array_equal(stopped.nodes, full.nodes[:n])
+    np.testing.assert_array_equal(stopped.cover_radii, full.cover_radii[:n])
+    np.testing.assert_array_equal(stopped.distances, full.distances[:n, :n])
+    assert stopped.cover_radius == full.cover_radii[n - 1] and (n == 3 or stopped.cover_radius <= cover)
+
+
 def test_lower_distances_is_exact_up_to_its_limit():
     # the invariant of _kernels.lower_distances: after each landmark with limit r,
     # to_set = d(x, L) where d(x, L) <= r, and to_set >= d(x, L) elsewhere

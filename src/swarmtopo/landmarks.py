@@ -45,6 +45,9 @@ from . import _kernels
 from ._validate import non_negative, positive, positive_int
 from .errors import InputError, SwarmtopoError
 
+MIN_LANDMARKS = 3
+"""The fewest landmarks a run stopped by its ``cover`` radius keeps (a triangle: the least that can hold a loop)."""
+
 Progress = Callable[[str], None]
 """Progress callback: receives the name of the stage that starts."""
 
@@ -80,7 +83,7 @@ class Landmarks:
 
 
 def maxmin(graph, n_landmarks: int, *, rng=None, progress: Progress | None = None,
-           candidates: np.ndarray | None = None) -> Landmarks:
+           candidates: np.ndarray | None = None, cover: float | None = None) -> Landmarks:
     """Maxmin (farthest-point) landmarks: l_k = argmax_x d(x, L).
 
     Parameters
@@ -98,6 +101,10 @@ def maxmin(graph, n_landmarks: int, *, rng=None, progress: Progress | None = Non
     candidates
         Optional (n_nodes,) bool mask: landmarks are drawn among these nodes only,
         and the covering radius is over them (distances still through every node).
+    cover
+        Optional radius: stop at the first pick that brings the covering radius to at
+        most ``cover`` (at least ``MIN_LANDMARKS`` picks), so L is then how many the
+        greedy run needs to cover within ``cover``, at most ``n_landmarks``.
 
     Returns
     -------
@@ -119,12 +126,12 @@ def maxmin(graph, n_landmarks: int, *, rng=None, progress: Progress | None = Non
                              f"got shape {candidates.shape} with {int(candidates.sum())} set")
     start = _random_candidate(candidates, rng)
     notify("picks")
-    nodes, radii = _pick(arrays, candidates, n_landmarks, start)
+    nodes, radii = _pick(arrays, candidates, n_landmarks, start, cover=cover)
     return _result(arrays, nodes, radii, "maxmin", {"start": start}, notify)
 
 
 def knn_maxmin(graph, n_landmarks: int, *, k: int = 10, q: float = 0.9, rng=None,
-               progress: Progress | None = None) -> Landmarks:
+               progress: Progress | None = None, cover: float | None = None) -> Landmarks:
     """KNN-filtered maxmin: maxmin on the points with d̄_k(x) <= tau_{q,k}.
 
     d̄_k(x) is the mean distance to the k nearest other points (events, so a node of
@@ -147,6 +154,8 @@ def knn_maxmin(graph, n_landmarks: int, *, k: int = 10, q: float = 0.9, rng=None
     progress
         Called with each stage's name as it starts (``"knn"``, ``"picks"``,
         ``"distances"``) and with ``"done"`` at the end.
+    cover
+        As for :func:`maxmin` (the covering radius over the kept set V).
 
     Returns
     -------
@@ -169,13 +178,13 @@ def knn_maxmin(graph, n_landmarks: int, *, k: int = 10, q: float = 0.9, rng=None
     candidates = mean_knn <= threshold
     start = _random_candidate(candidates, rng)
     notify("picks")
-    nodes, radii = _pick(arrays, candidates, n_landmarks, start)
+    nodes, radii = _pick(arrays, candidates, n_landmarks, start, cover=cover)
     params = {"k": k, "q": q, "threshold": threshold, "n_kept": int(candidates.sum()), "start": start}
     return _result(arrays, nodes, radii, "knn", params, notify)
 
 
 def probabilistic_maxmin(graph, n_landmarks: int, *, k: int = 10, omega: float = 1.0,
-                         rng=None, progress: Progress | None = None) -> Landmarks:
+                         rng=None, progress: Progress | None = None, cover: float | None = None) -> Landmarks:
     r"""Probabilistic maxmin: l_k = argmax_x alpha(d(x, L), v(x)), alpha(u, v) = u + omega v.
 
     The paper's v is a local density and omega a constant, which makes omega carry
@@ -207,6 +216,8 @@ def probabilistic_maxmin(graph, n_landmarks: int, *, k: int = 10, omega: float =
         Seed or Generator; l_1 is a node drawn uniformly at random.
     progress
         As for :func:`knn_maxmin`.
+    cover
+        As for :func:`maxmin`.
 
     Returns
     -------
@@ -226,7 +237,7 @@ def probabilistic_maxmin(graph, n_landmarks: int, *, k: int = 10, omega: float =
     start = _random_candidate(candidates, rng)
     notify("picks")
     nodes, radii = _pick(arrays, candidates, n_landmarks, start,
-                         bonus=lambda radius: (omega * radius) * density_rank)
+                         bonus=lambda radius: (omega * radius) * density_rank, cover=cover)
     params = {"k": k, "omega": omega, "start": start}
     return _result(arrays, nodes, radii, "probabilistic", params, notify)
 
@@ -325,7 +336,8 @@ def _density_rank(mean_knn: np.ndarray, multiplicity: np.ndarray) -> np.ndarray:
 
 
 def _pick(arrays: _GraphArrays, candidates: np.ndarray, n_landmarks: int, start: int,
-          bonus: Callable[[float], np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
+          bonus: Callable[[float], np.ndarray] | None = None,
+          cover: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Sequential landmark picks.
 
     ``to_set`` holds d(x, L); each new landmark lowers it with a search that stops
@@ -334,8 +346,10 @@ def _pick(arrays: _GraphArrays, candidates: np.ndarray, n_landmarks: int, start:
     with candidates in a band of a window the searches stay out of the rest of it).
     ``u`` is d(x, L) on the candidates and -inf elsewhere, so non-candidates never win
     an argmax nor count in the covering radius r = max u.  The next landmark is argmax
-    u (maxmin) or argmax u + bonus(r) over non-landmarks.  Returns the landmark nodes
-    and the covering radius after each pick.  The graph must be connected.
+    u (maxmin) or argmax u + bonus(r) over non-landmarks.  Picks stop at ``n_landmarks``
+    or, with ``cover``, once r <= ``cover`` has been reached and there are at least
+    ``MIN_LANDMARKS``.  Returns the landmark nodes and the covering radius after each
+    pick.  The graph must be connected.
     """
     n_landmarks = min(n_landmarks, int(candidates.sum()))
     search = _kernels.Searcher(arrays.indptr, arrays.indices, arrays.weights)
@@ -345,13 +359,15 @@ def _pick(arrays: _GraphArrays, candidates: np.ndarray, n_landmarks: int, start:
     radii = np.empty(n_landmarks)
     landmark = start
     radius = np.inf  # before the first pick nothing is covered
+    covered = False
     for i in range(n_landmarks):
         nodes[i] = landmark
         is_landmark[landmark] = True
         search.add_landmark(landmark, to_set, radius)
         u = np.where(candidates, to_set, -np.inf)
         radius = radii[i] = u.max()
-        if i + 1 == n_landmarks:
+        covered = covered or (cover is not None and radius <= cover)
+        if i + 1 == n_landmarks or (covered and i + 1 >= MIN_LANDMARKS):
             break
         if bonus is None:
             # weights > 0, so every candidate that is not a landmark has u > 0 = u(landmark)
@@ -360,7 +376,7 @@ def _pick(arrays: _GraphArrays, candidates: np.ndarray, n_landmarks: int, start:
             score = u + bonus(radius)
             score[is_landmark] = -np.inf
             landmark = int(np.argmax(score))
-    return nodes, radii
+    return nodes[:i + 1], radii[:i + 1]
 
 
 def _landmark_distances(arrays: _GraphArrays, nodes: np.ndarray) -> np.ndarray:

@@ -740,9 +740,9 @@ def _map_window(span, sub: EncounterGraph, knn_scale: float, n_land: int | None,
     t0 = time.perf_counter()
     t_lo, t_hi = (float(sub.event_t.min()), float(sub.event_t.max())) if span is None else span
     candidates = None if band == 1 else in_band(sub.node_times(), (t_lo, t_hi), band)
-    if n_land is None:
-        land = _subsample(sub, config, min(config.max_landmarks, sub.n_nodes), rng, candidates)
-        land = _first_covering(land, AUTO_COVER_FACTOR * knn_scale)
+    if n_land is None:  # as many as cover the window to AUTO_COVER_FACTOR s, at most max_landmarks
+        land = _subsample(sub, config, min(config.max_landmarks, sub.n_nodes), rng, candidates,
+                          cover=AUTO_COVER_FACTOR * knn_scale)
     else:
         land = _subsample(sub, config, int(min(n_land, sub.n_nodes)), rng, candidates)
     timings["landmarks"] += time.perf_counter() - t0
@@ -1016,23 +1016,14 @@ def _sampling_warnings(scales: RegionScales, n_landmarks: int, config: MapConfig
 
 
 def _subsample(graph: EncounterGraph, config: MapConfig, n_landmarks: int, rng,
-               candidates: np.ndarray | None = None) -> Landmarks:
-    """Landmarks by ``config.subsample``; ``candidates`` (maxmin only, as validated) restricts the picks."""
+               candidates: np.ndarray | None = None, cover: float | None = None) -> Landmarks:
+    """Landmarks by ``config.subsample``; ``candidates`` (maxmin only, as validated) restricts
+    the picks; ``cover`` stops them once they cover within it (``landmarks.maxmin``)."""
     if config.subsample == "knn":
-        return knn_maxmin(graph, n_landmarks, k=config.knn_k, q=config.knn_q, rng=rng)
+        return knn_maxmin(graph, n_landmarks, k=config.knn_k, q=config.knn_q, rng=rng, cover=cover)
     if config.subsample == "probabilistic":
-        return probabilistic_maxmin(graph, n_landmarks, k=config.knn_k, omega=config.omega, rng=rng)
-    return maxmin(graph, n_landmarks, rng=rng, candidates=candidates)
-
-
-def _first_covering(land: Landmarks, radius: float) -> Landmarks:
-    """The first landmarks of a greedy run whose covering radius is <= ``radius``
-    (all of them if none is; at least 3)."""
-    within = np.flatnonzero(land.cover_radii <= radius)
-    n = max(int(within[0]) + 1, 3) if len(within) else len(land.nodes)
-    n = min(n, len(land.nodes))
-    return replace(land, nodes=land.nodes[:n], distances=land.distances[:n, :n],
-                   cover_radius=float(land.cover_radii[n - 1]), cover_radii=land.cover_radii[:n])
+        return probabilistic_maxmin(graph, n_landmarks, k=config.knn_k, omega=config.omega, rng=rng, cover=cover)
+    return maxmin(graph, n_landmarks, rng=rng, candidates=candidates, cover=cover)
 
 
 def _share_landmarks(total: int, events: np.ndarray) -> np.ndarray:
