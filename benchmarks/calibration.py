@@ -22,7 +22,9 @@ Feature sets: ``z`` (how many standard errors the pooled scores are from changin
 vote, ``ratio.standardised_margin``; the previous calibration); z and the windows'
 resolution ln L (``ratio.resolution``); those and z ln L (shipped); those and ln #windows;
 the calibration before z (agreement of the windows with the vote, log margin, ln #windows).
-Each is fitted on both sets; last, z fitted on the tuning maps alone, as before the grid.
+Each is fitted on both sets; then how often a draw of the reporting suite's size
+(390 maps) from the tuning maps shows the shipped features no better than the constant;
+last, z fitted on the tuning maps alone, as before the grid.
 
     python benchmarks/calibration.py [--store tuning.duckdb] [--reading contact-trace]
 """
@@ -37,7 +39,7 @@ from sklearn.metrics import log_loss
 from sklearn.model_selection import KFold, cross_val_predict
 
 from swarmtopo.classify import load_classifier
-from swarmtopo.experiments.accuracy import CELLS, PLANNING_CELLS, cell_of, reliability
+from swarmtopo.experiments.accuracy import CELLS, PLANNING_CELLS, REPORTING_PER_CELL, brier_gain, cell_of, reliability
 from swarmtopo.experiments.store import read_jobs
 from swarmtopo.experiments.sweep import INPUTS, map_input
 from swarmtopo.experiments.tuning import (cross_fitted_features, features_under, fit_thresholds, job_pipeline,
@@ -78,6 +80,16 @@ def _scores(name: str, y: np.ndarray, p: np.ndarray) -> None:
               f"{b['fraction_right']:.3f} |")
 
 
+def suite_sized_draws(y: np.ndarray, p: np.ndarray, size: int, draws: int = 4000) -> str:
+    """How often a draw of ``size`` of these maps (the reporting suite's size; with
+    replacement, seed 0) shows the confidences ``p`` no better than a constant equal to
+    the draw's rate: how much one suite-sized sample can say about the Brier gain."""
+    rows = np.random.default_rng(0).integers(0, len(y), (draws, size))
+    gains = brier_gain(p[rows], y[rows])
+    return (f"shipped features, draws of {size} tuning maps ({draws}): the Brier gain over the constant is "
+            f"<= 0 in {np.mean(gains <= 0):.1%} of them (median gain {np.median(gains):+.4f})")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--store", default="tuning.duckdb", help="a store written by scripts/tune_accuracy.py")
@@ -94,12 +106,15 @@ def main() -> None:
           f"{int((~y[~on_grid]).sum())} wrong when read with thresholds fitted without them; {len(grid)} "
           f"calibration-grid maps, {len(grid_correct)} with one region, {int((~y[on_grid]).sum())} wrong")
     folds = KFold(10, shuffle=True, random_state=0)
+    predictions = {}
     for name, columns in FEATURE_SETS.items():
         X = confidence_design(features + grid_features, columns)
-        p = cross_val_predict(confidence_model(), X, y, cv=folds, method="predict_proba")[:, 1]
+        p = predictions[name] = cross_val_predict(confidence_model(), X, y, cv=folds, method="predict_proba")[:, 1]
         print(f"\n## {name}")
         _scores("tuning maps", y[~on_grid], p[~on_grid])
         _scores("calibration grid", y[on_grid], p[on_grid])
+    shipped = predictions[next(name for name, columns in FEATURE_SETS.items() if columns == CONFIDENCE_FEATURES)]
+    print("\n" + suite_sized_draws(y[~on_grid], shipped[~on_grid], REPORTING_PER_CELL * len(CELLS)))
     alone = cross_val_predict(confidence_model(), confidence_design(features, ("z",)), y[~on_grid], cv=folds,
                               method="predict_proba")[:, 1]
     print("\n## z fitted on the tuning maps alone (the calibration before the grid)")
