@@ -431,10 +431,10 @@ def _padded(log, seed, factor):
         current["span"], current["band"] = span, band
         return original_map(span, sub, knn_scale, n_land, config, rng, timings, say, band)
 
-    def subsample(graph, config, n_landmarks, rng, candidates=None):
+    def subsample(graph, config, n_landmarks, rng, candidates=None, cover=None):
         if current["span"] is None:
-            return original_subsample(graph, config, n_landmarks, rng, candidates)
-        return L.maxmin(graph, n_landmarks, rng=rng,
+            return original_subsample(graph, config, n_landmarks, rng, candidates, cover)
+        return L.maxmin(graph, n_landmarks, rng=rng, cover=cover,
                         candidates=P.in_band(graph.node_times(), current["span"], current["band"]))
 
     P.build_graph, P._map_window, P._subsample = build, map_window, subsample

@@ -76,18 +76,22 @@ def _farthest_points(positions: np.ndarray, count: int, start: int) -> np.ndarra
 def _truth_maxmin(truth):
     """A stand-in for the pipeline's subsampler: landmarks in maxmin order on the true
     positions of the graph's nodes (their representative events), covering radii in the
-    encounter metric (as maxmin's, so the pipeline's covering rule applies unchanged)."""
-    def subsample(graph, config, n_landmarks, rng, candidates=None):
+    encounter metric (as maxmin's, so the pipeline's covering rule, ``cover``, applies unchanged)."""
+    def subsample(graph, config, n_landmarks, rng, candidates=None, cover=None):
         arrays = L._GraphArrays.of(graph)
         positions = event_positions(truth, graph.representative_event())
         start = int(np.random.default_rng(rng).integers(len(positions)))
         nodes = _farthest_points(positions, n_landmarks, start)
         search = _kernels.Searcher(arrays.indptr, arrays.indices, arrays.weights)
         to_set, radii = np.full(arrays.n, np.inf), np.empty(len(nodes))
+        covered = False
         for i, node in enumerate(nodes):
             search.add_landmark(int(node), to_set)
             radii[i] = to_set.max()
-        return L._result(arrays, nodes, radii, "truth-maxmin", {"start": start}, L._quiet)
+            covered = covered or (cover is not None and radii[i] <= cover)
+            if covered and i + 1 >= L.MIN_LANDMARKS:
+                break
+        return L._result(arrays, nodes[:i + 1], radii[:i + 1], "truth-maxmin", {"start": start}, L._quiet)
     return subsample
 
 
