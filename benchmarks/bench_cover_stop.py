@@ -18,13 +18,13 @@ from __future__ import annotations
 import argparse
 import statistics
 import time
-from dataclasses import replace
 
 import numpy as np
 
 from _data import simulated_log
 from _measure import machine, revision
 from swarmtopo import pipeline
+from swarmtopo.landmarks import covering_prefix
 from swarmtopo.pipeline import MapConfig, map_encounters
 
 SHIPPED = pipeline._subsample
@@ -33,12 +33,7 @@ SHIPPED = pipeline._subsample
 def cut_after(graph, config, n_landmarks, rng, candidates=None, cover=None):
     """The baseline: every pick up to ``n_landmarks``, then the prefix ``cover`` keeps."""
     land = SHIPPED(graph, config, n_landmarks, rng, candidates)
-    if cover is None:
-        return land
-    within = np.flatnonzero(land.cover_radii <= cover)
-    n = min(max(int(within[0]) + 1, 3) if len(within) else len(land.nodes), len(land.nodes))
-    return replace(land, nodes=land.nodes[:n], distances=land.distances[:n, :n],
-                   cover_radius=float(land.cover_radii[n - 1]), cover_radii=land.cover_radii[:n])
+    return land if cover is None else covering_prefix(land, cover)
 
 
 def timed_map(log, baseline: bool):

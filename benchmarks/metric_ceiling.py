@@ -84,14 +84,11 @@ def _truth_maxmin(truth):
         nodes = _farthest_points(positions, n_landmarks, start)
         search = _kernels.Searcher(arrays.indptr, arrays.indices, arrays.weights)
         to_set, radii = np.full(arrays.n, np.inf), np.empty(len(nodes))
-        covered = False
         for i, node in enumerate(nodes):
             search.add_landmark(int(node), to_set)
             radii[i] = to_set.max()
-            covered = covered or (cover is not None and radii[i] <= cover)
-            if covered and i + 1 >= L.MIN_LANDMARKS:
-                break
-        return L._result(arrays, nodes[:i + 1], radii[:i + 1], "truth-maxmin", {"start": start}, L._quiet)
+        land = L._result(arrays, nodes, radii, "truth-maxmin", {"start": start}, L._quiet)
+        return land if cover is None else L.covering_prefix(land, cover)
     return subsample
 
 

@@ -11,7 +11,7 @@ from scipy.spatial import cKDTree
 
 from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.graph import build_graph, literal_distances
-from swarmtopo.landmarks import (SUBSAMPLERS, Landmarks, knn_distances, knn_maxmin, maxmin,
+from swarmtopo.landmarks import (SUBSAMPLERS, Landmarks, covering_prefix, knn_distances, knn_maxmin, maxmin,
                                  probabilistic_maxmin)
 from swarmtopo.log import EncounterLog
 
@@ -166,6 +166,7 @@ def test_cover_stops_the_run_at_its_first_covering_prefix(subsample, quantile):
     np.testing.assert_array_equal(stopped.cover_radii, full.cover_radii[:n])
     np.testing.assert_array_equal(stopped.distances, full.distances[:n, :n])
     assert stopped.cover_radius == full.cover_radii[n - 1] and (n == 3 or stopped.cover_radius <= cover)
+    np.testing.assert_array_equal(covering_prefix(full, cover).distances, stopped.distances)  # read off the full run
 
 
 def test_lower_distances_is_exact_up_to_its_limit():

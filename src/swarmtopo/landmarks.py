@@ -379,6 +379,16 @@ def _pick(arrays: _GraphArrays, candidates: np.ndarray, n_landmarks: int, start:
     return nodes[:i + 1], radii[:i + 1]
 
 
+def covering_prefix(land: Landmarks, cover: float) -> Landmarks:
+    """The first landmarks of a whole greedy run that a run with ``cover`` keeps (the first
+    pick whose covering radius is <= ``cover``, at least ``MIN_LANDMARKS``; all of them if
+    none is): what ``cover`` stops at, read off a run that did not stop."""
+    within = np.flatnonzero(land.cover_radii <= cover)
+    n = min(max(int(within[0]) + 1, MIN_LANDMARKS) if len(within) else len(land.nodes), len(land.nodes))
+    return Landmarks(nodes=land.nodes[:n], distances=land.distances[:n, :n], cover_radius=float(land.cover_radii[n - 1]),
+                     cover_radii=land.cover_radii[:n], method=land.method, params=land.params)
+
+
 def _landmark_distances(arrays: _GraphArrays, nodes: np.ndarray) -> np.ndarray:
     """Exact (L, L) distances: one search per landmark, stopped at the last landmark."""
     rows = _kernels.rows_to_targets(arrays.indptr, arrays.indices, arrays.weights, nodes, nodes)

@@ -195,7 +195,7 @@ def run_job(job: Job) -> dict[str, Any]:
         log = stripped_log(sim.log)
         tmap = map_encounters(contact_trace(log) if map_input(mapping) == "contact-trace" else log,
                               job_map_config(mapping, seeds["map"]),
-                              classifier=_classifier(job_classifier(mapping), job.file("map.classifier")))
+                              classifier=cached_classifier(job_classifier(mapping), job.file("map.classifier")))
     except SwarmtopoError as exc:
         row["error"] = " ".join(str(exc).split())
     else:
@@ -405,8 +405,9 @@ def dask_setup(worker) -> None:
 
 
 @lru_cache(maxsize=8)
-def _classifier(name: str, path: str | None) -> BettiClassifier:
-    """The classifier of a job, loaded once per worker process."""
+def cached_classifier(name: str, path: str | None = None) -> BettiClassifier:
+    """The classifier of a job: the preset ``name``, else the file at ``path``; loaded
+    once per process (per worker, or per store read by the tuning code)."""
     return load_classifier(name if name in PRESETS else path)
 
 

@@ -26,10 +26,9 @@ from scipy.ndimage import uniform_filter, uniform_filter1d
 
 from ..persistence import Diagram
 from ..agreement import BARS, agreement_array
-from ..classify import load_classifier
 from ..pipeline import MapConfig, resolve_landmark_bands
 from ..ratio import CONFIDENCE_FEATURES, RatioClassifier, RatioThresholds, pooled_scores, region_reader, window_scores
-from .sweep import job_classifier, job_map_config
+from .sweep import cached_classifier, job_classifier, job_map_config
 
 Q_GRID = (0.5, 0.6, 0.7, 0.8, 0.9)
 TAU_GRID = tuple(np.round(np.geomspace(1.2, 12.0, 80), 4))
@@ -46,7 +45,7 @@ chosen candidate's must be MapConfig's defaults."""
 def job_pipeline(mapping: dict) -> dict:
     """The ``PIPELINE_FIELDS`` a stored job was mapped with (its ``[map]`` table; unset
     landmark bands resolved by the preset classifier that ran it, as ``run_job`` does)."""
-    return pipeline_fields(job_map_config(mapping), load_classifier(job_classifier(mapping)))
+    return pipeline_fields(job_map_config(mapping), cached_classifier(job_classifier(mapping)))
 
 
 def pipeline_fields(config: MapConfig, classifier) -> dict:
