@@ -71,7 +71,8 @@ diffusion time, wall following x 2):
 * ``paths-C`` -- landmarks and Vietoris-Rips on the window's chain graph with every
   edge cut into pieces of at most C x its k-NN scale: points along the agents' paths
   between two encounters (event-to-event distances unchanged), so landmarks can sit
-  where agents passed without meeting.
+  where agents passed without meeting.  Whole-window landmarks only (``landmark_bands=1``):
+  the new points have no time of their own to place them in a band.
 * ``dtm-K`` -- the DTM-filtration of the landmarks (p = 1, Anai et al. 2019) instead of
   Vietoris-Rips: l_i enters at f_i, the root mean square of its distances to its K
   nearest nodes, and edge ij at max(f_i, f_j, (f_i + f_j + d_ij) / 2), so landmarks
@@ -397,6 +398,7 @@ def _trajectory(log, seed, factor):
     original = P._map_window
 
     def window_on_paths(span, sub, knn_scale, n_land, config, rng, timings, say, band=1.0):
+        assert band == 1.0, band
         dense = _subdivided(sub, factor * knn_scale)
         land = P._subsample(dense, config, min(config.max_landmarks, dense.n_nodes), rng,
                             cover=P.AUTO_COVER_FACTOR * knn_scale)
@@ -408,7 +410,7 @@ def _trajectory(log, seed, factor):
 
     P._map_window = window_on_paths
     try:
-        return _windows_of(log, seed)
+        return _windows_of(log, seed, landmark_bands=(1.0,))
     finally:
         P._map_window = original
 

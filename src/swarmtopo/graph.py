@@ -113,6 +113,7 @@ numbered by their earliest event.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -166,13 +167,15 @@ class EncounterGraph:
 
     def representative_event(self) -> np.ndarray:
         """Original-log index of the earliest event of each node, shape ``(n_nodes,)``."""
-        return self.event_index[self._first_events()]
+        return self.event_index[self._first_events]
 
     def node_times(self) -> np.ndarray:
         """Time of each node: its earliest event's (``event_t`` is non-decreasing), shape ``(n_nodes,)``."""
-        return self.event_t[self._first_events()]
+        return self.event_t[self._first_events]
 
+    @cached_property
     def _first_events(self) -> np.ndarray:
+        """Index (into the graph's events) of each node's earliest event, found once per graph."""
         _, first = np.unique(self.node_of_event, return_index=True)
         return first
 
