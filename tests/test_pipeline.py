@@ -327,6 +327,22 @@ def test_landmark_bands_map_each_window_once_per_band_from_its_middle():
     assert windows[1].to_json()["band"] == 0.5
 
 
+def test_a_band_with_an_empty_middle_is_left_out_and_said():
+    # the ring's encounters come at t ~ 5 s and ~ 6 s only: the middle half of the log is empty
+    log = ring_log()
+    config = MapConfig(metric="plain", landmarks=60, min_region_events=10, embed_dim=0, window_length=np.inf,
+                       landmark_bands=(1.0, 0.5))
+    region = map_encounters(log, config).regions[0]
+    assert [w.band for w in region.windows] == [1.0]
+    assert any("a landmark band draws from" in w and ": 1;" in w for w in region.warnings)
+    whole = map_encounters(log, replace(config, landmark_bands=(1.0,))).regions[0]
+    assert np.array_equal(region.diagram[1], whole.diagram[1]) and not whole.warnings
+    # with no band that can be drawn from, the window keeps whole-window landmarks
+    middle_only = map_encounters(log, replace(config, landmark_bands=(0.5,))).regions[0]
+    assert [w.band for w in middle_only.windows] == [1.0]
+    assert np.array_equal(middle_only.diagram[1], whole.diagram[1])
+
+
 def test_unset_landmark_bands_are_the_classifiers_own():
     log = simulate(default_arena(), 150, 30.0, rng=2).log
     base = dict(window_encounters=8.0, window_scales=(1.0,), seed=4, embed_dim=0)

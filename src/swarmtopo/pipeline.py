@@ -34,7 +34,8 @@ from .embed import Embedding, mds
 from .errors import InputError, SwarmtopoError
 from .graph import METRICS, EncounterGraph, agent_gaps, build_graph
 from .io import jsonable
-from .landmarks import SUBSAMPLERS, Landmarks, knn_distances, knn_maxmin, maxmin, probabilistic_maxmin
+from .landmarks import (MIN_LANDMARKS, SUBSAMPLERS, Landmarks, knn_distances, knn_maxmin, maxmin,
+                        probabilistic_maxmin)
 from .log import EncounterLog, exact_time
 from .persistence import Diagram, PersistenceResult, rips_persistence
 from .agreement import overlapping, rank_agreement, window_coordinates
@@ -614,31 +615,41 @@ def map_encounters(
     for comp, n_land in zip(regions_idx, shares):
         region_events = graph.event_index[event_comp == comp]
         windows, parts = [], []  # the region's windows and (if kept) the graphs they were mapped on
+        quiet = 0  # windows with a band left out (too few nodes in its middle share)
         for span, wgraph, wlabels in window_graphs:
             part = _region_part(wgraph, wlabels, region_events, log, config)
             if part is not None:
                 knn_scale = _timed_knn_scale(part, config, timings)  # one per window, whatever its bands
-                for band in config.landmark_bands:
+                bands = usable_bands(part, span, config.landmark_bands)
+                quiet += len(bands) < len(config.landmark_bands)
+                for band in bands:
                     windows.append(_map_window(span, part, knn_scale, n_land, config, rng, timings, say, band))
                     parts.append(part if keep_graphs else None)
         fallback = []
         if not windows:  # no window holds enough of this region: map its whole log instead
             whole = graph.subgraph(np.flatnonzero(labels == comp))
             knn_scale = _timed_knn_scale(whole, config, timings)
+            bands = usable_bands(whole, None, config.landmark_bands)
+            quiet = int(len(bands) < len(config.landmark_bands))
             windows = [_map_window(None, whole, knn_scale, n_land, config, rng, timings, say, band)
-                       for band in config.landmark_bands]
+                       for band in bands]
             parts = [whole] * len(windows)
             if lengths_tried:
                 lo, hi = lengths_tried[0], lengths_tried[-1]
                 tried = f"{lo:.3g}" if lo == hi else f"{lo:.3g}-{hi:.3g}"
                 fallback = [f"no window ({tried} s long) holds {config.min_region_events} encounters of this region "
                             f"among {MIN_REGION_AGENTS} agents: its whole log was mapped instead"]
+        if quiet:
+            fallback.append(f"windows of this region with fewer than {MIN_LANDMARKS} encounters in the middle share "
+                            f"of their time span a landmark band draws from (a quiet stretch of the log): {quiet}; "
+                            f"they were mapped without that band")
         diagrams = [w.diagram for w in windows]
         agreement = None
         if config.agreement == "always" or (gated and classifier.needs_agreement(diagrams)):
             say("agreement")
             t0 = time.perf_counter()
-            first_band = [i for i, w in enumerate(windows) if w.band == config.landmark_bands[0]]
+            spans = [(w.t0, w.t1) for w in windows]
+            first_band = [i for i, span in enumerate(spans) if span not in spans[:i]]  # one map per window
             agreement = region_agreement([windows[i] for i in first_band], [parts[i] for i in first_band])
             timings["agreement"] += time.perf_counter() - t0
         del parts
@@ -755,6 +766,18 @@ def _map_window(span, sub: EncounterGraph, knn_scale: float, n_land: int | None,
                      landmark_events=sub.representative_event()[land.nodes],
                      scales=RegionScales(knn=knn_scale, cover_radius=float(land.cover_radius)),
                      persistence=persistence, band=float(band))
+
+
+def usable_bands(sub: EncounterGraph, span: tuple[float, float] | None, bands: tuple[float, ...]) -> list[float]:
+    """The landmark ``bands`` a window can be mapped with: those whose middle share of the
+    window's span (None: its events' first to last time) holds at least ``MIN_LANDMARKS``
+    nodes -- a quiet stretch of the log can leave it (nearly) empty; whole-window
+    landmarks (band 1) if none does."""
+    t_lo, t_hi = (float(sub.event_t.min()), float(sub.event_t.max())) if span is None else span
+    times = sub.node_times()
+    usable = [band for band in bands
+              if band == 1 or np.count_nonzero(in_band(times, (t_lo, t_hi), band)) >= MIN_LANDMARKS]
+    return usable or [1.0]
 
 
 def in_band(times: np.ndarray, span: tuple[float, float], band: float) -> np.ndarray:
