@@ -127,6 +127,12 @@ def test_threshold_is_drawn_in_the_diagram(demo):
     assert line["x"][0] == 0 and line["y"][0] == tau and line["y"][1] - line["x"][1] == pytest.approx(tau)
     segment = next(t for t in fig["data"] if t.get("xaxis") == "x2" and t.get("x") == [0, tau])
     assert segment["line"]["dash"] == "dash"
+    # the note names the formula the value comes from: tau_n l_q (the shipped classifier's), by hand
+    theta = doc["classifier"]["theta"]["1"]
+    finite = [b[1] - b[0] for b in doc["regions"][0]["diagrams"]["1"] if b[1] is not None]
+    assert tau == pytest.approx(theta["tau"] * np.quantile(finite, theta["q"]))
+    assert doc["classifier"]["threshold"] == "tau_n l_q"
+    assert "threshold &tau;<sub>n</sub> l<sub>q</sub> (" in demo["html"] and "&Delta;" not in demo["html"]
     # The diagram's H1 points are map.json's finite H1 bars.
     h1 = [b for b in doc["regions"][0]["diagrams"]["1"] if b[1] is not None]
     points = next(t for t in fig["data"] if t.get("name", "").startswith("H1 ("))

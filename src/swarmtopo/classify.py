@@ -295,6 +295,7 @@ class BettiClassifier(BaseEstimator):
             "classifier": self.provenance_.get("name", "custom"),
             "definition": "beta_n = #{bars of dim n with length / (l_q + Delta) > tau}, "
                           "l_q = q-quantile of the dim-n bar lengths",
+            "threshold": "tau_n (l_q + Delta_n)",
             "theta": {str(n): th.to_json() for n, th in self.theta_.items()},
             "confidence": "P(correct) from a logistic model of the log-ratio margin of the nearest bar to "
                           "the threshold and the gap around it, fitted on held-out maps",

@@ -492,6 +492,7 @@ class RatioClassifier:
             "classifier": self.provenance_.get("name", "custom"),
             "definition": f"beta_n = {pooled}",
             "pooling": self.pooling,
+            "threshold": "tau_n l_q",
             "theta": {str(n): th.to_json() for n, th in self.thresholds_.items()},
             **({"agreement_gate": "a rank whose mean score passes is not counted when its cross-window cycle "
                 "agreement A_k (the correlation of its loop's circular coordinates in overlapping windows, on the "

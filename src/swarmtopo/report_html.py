@@ -209,9 +209,18 @@ def _persistence_section(tmap: TopologicalMap, doc: dict, figures: dict) -> str:
     return ('<section id="persistence"><h2>Persistence diagram and barcode</h2>\n'
             '<p class="note">Each point (bar) is a feature of the Vietoris-Rips filtration of the landmarks in the '
             "encounter metric, born at one scale and dead at a larger one (seconds). The dotted line (left) and "
-            "the dashed segment (right) mark the classifier's threshold &tau;<sub>n</sub>(l<sub>q</sub> + "
-            "&Delta;<sub>n</sub>): bars longer than it count as holes; shorter ones are drawn faded.</p>"
+            f"the dashed segment (right) mark the classifier's threshold {_threshold_html(tmap.classifier)} "
+            "(l<sub>q</sub>: the q-quantile of the bar lengths of the window shown): bars longer than it count "
+            "as holes; shorter ones are drawn faded.</p>"
             f'{"".join(parts)}</section>\n')
+
+
+def _threshold_html(classifier: dict) -> str:
+    """The classifier's length threshold (``describe()["threshold"]``, e.g. "tau_n l_q") in HTML."""
+    text = html.escape(classifier["threshold"])
+    for plain, marked in (("tau_n", "&tau;<sub>n</sub>"), ("Delta_n", "&Delta;<sub>n</sub>"), ("l_q", "l<sub>q</sub>")):
+        text = text.replace(plain, marked)
+    return text
 
 
 def _cloud_section(tmap: TopologicalMap, log: EncounterLog, truth, arena, figures: dict) -> str:
