@@ -437,6 +437,10 @@ def test_geojson_units_are_converted_to_mm(units, mm):
     assert arena.area == pytest.approx(0.25 * mm ** 2) and arena.bounds == pytest.approx((0, 0, 0.5 * mm, 0.5 * mm))
     collection = {"type": "FeatureCollection", "features": [feature]}
     assert Arena.from_geojson(collection) == arena
+    # units set once on the collection hold for its features that set none, not for one that does
+    bare = {"type": "Feature", "geometry": {"type": "Polygon", "coordinates": square}}
+    assert Arena.from_geojson({**collection, "features": [bare], "properties": {"units": units}}) == arena
+    assert Arena.from_geojson({**collection, "properties": {"units": "cm" if units == "m" else "m"}}) == arena
 
 
 def test_a_nan_coordinate_is_refused_without_a_shapely_warning(recwarn):

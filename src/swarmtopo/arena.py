@@ -183,18 +183,20 @@ class Arena:
             if not isinstance(feats, list) or not feats:
                 raise ArenaError("FeatureCollection holds no features", file=source)
             polys = []
+            collection_units = _units(obj, source)
             for i, feat in enumerate(feats):
                 if not isinstance(feat, dict) or feat.get("type") != "Feature":
                     raise ArenaError(f"feature {i} is not a GeoJSON Feature", file=source)
                 if not feat.get("geometry"):
                     raise ArenaError(f"feature {i} has no geometry", file=source)
-                geom = _geometry_from(feat["geometry"], source, f"feature {i}: ", _units(feat, source, f"feature {i}: "))
+                units = _units(feat, source, f"feature {i}: ", collection_units)
+                geom = _geometry_from(feat["geometry"], source, f"feature {i}: ", MM_PER_UNIT[units])
                 polys.extend(geom.geoms if isinstance(geom, MultiPolygon) else [geom])
             return cls(MultiPolygon(polys), source=source)
         if kind == "Feature":
             if not obj.get("geometry"):
                 raise ArenaError("Feature has no geometry", file=source)
-            return cls(_geometry_from(obj["geometry"], source, "", _units(obj, source)), source=source)
+            return cls(_geometry_from(obj["geometry"], source, "", MM_PER_UNIT[_units(obj, source)]), source=source)
         return cls(_geometry_from(obj, source), source=source)
 
     @cached_property
@@ -507,14 +509,16 @@ MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0}
 """Units a Feature's ``properties.units`` may name; coordinates are converted to mm."""
 
 
-def _units(feature: dict, source, where: str = "") -> float:
-    """mm per unit of a Feature's coordinates (``properties.units``; mm when absent)."""
+def _units(feature: dict, source, where: str = "", default: str = "mm") -> str:
+    """The units of a Feature's coordinates (``properties.units``; ``default`` when absent):
+    a key of ``MM_PER_UNIT``.  A FeatureCollection's own ``properties.units`` (not standard
+    GeoJSON, but what a user writes to set them once) is the default of its features."""
     properties = feature.get("properties")
-    units = properties.get("units", "mm") if isinstance(properties, dict) else "mm"
+    units = properties.get("units", default) if isinstance(properties, dict) else default
     if not isinstance(units, str) or units not in MM_PER_UNIT:
         raise ArenaError(f"{where}properties.units {units!r} is not supported; expected one of "
                          f"{', '.join(MM_PER_UNIT)}", file=source)
-    return MM_PER_UNIT[units]
+    return units
 
 
 def _numbers_only(coordinates, source, where: str) -> None:
