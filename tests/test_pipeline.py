@@ -1,6 +1,7 @@
 """End-to-end mapping: log -> TopologicalMap, checked against known topology."""
 
 import json
+import re
 from dataclasses import replace
 
 import numpy as np
@@ -128,6 +129,9 @@ def test_empty_windows_do_not_take_seats_under_the_cap():
 def test_windows_too_short_to_list_are_refused_and_too_short_to_hold_a_region_say_so():
     with pytest.raises(SwarmtopoError, match="would be 799,999, more than 100,000: use longer windows"):
         _windows(np.array([0.0, 40.0]), 1e-4)  # 1 + (40 - 1e-4) / 5e-5 windows
+    for length, count in ((1e-300, "8e+301"), (1e-320, "inf")):  # said in short, never an OverflowError
+        with pytest.raises(SwarmtopoError, match=f"would be {re.escape(count)}, more than 100,000"):
+            _windows(np.array([0.0, 40.0]), length)
     log = simulate(default_arena(), 100, 10.0, rng=3).log
     tmap = map_encounters(log, MapConfig(window_length=0.01, window_scales=(1.0, 2.0), **FAST))
     assert tmap.regions[0].warnings[0] == ("no window (0.01-0.02 s long) holds 50 encounters of this region "
@@ -159,7 +163,9 @@ def test_window_restricts_events():
 @pytest.mark.parametrize("bad, match", [
     (dict(metric="euclid"), "unknown metric"),
     (dict(subsample="random"), "unknown subsampler"),
-    (dict(landmarks=2), "at least 3"),
+    (dict(landmarks=2), r"landmarks must be in 3\.\.2000"),
+    (dict(landmarks=2001), r"landmarks must be in 3\.\.2000"),
+    (dict(max_landmarks=2001), r"max_landmarks must be in 3\.\.2000"),
     (dict(maxdim=3), "maxdim"),
     (dict(window=(5.0, 1.0)), "before its start"),
     (dict(hop_cost=-1.0), "hop_cost"),

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from swarmtopo.errors import InputError, SwarmtopoError
-from swarmtopo.experiments.grid import expand_grid, read_sweep
+from swarmtopo.experiments.grid import PARAMS, STORE_INT_MAX, expand_grid, read_sweep
 from swarmtopo.experiments.store import RUN_COLUMNS, ResultStore, read_jobs
 from swarmtopo.experiments.sweep import job_map_config, run_job, run_sweep
 from swarmtopo.pipeline import MapConfig
@@ -187,7 +187,29 @@ def test_keys_are_the_same_in_another_process():
     ("[swarm]\nagents = [200, 0]", ["[swarm] agents = 0", "integer >= 1"]),
     ("[swarm]\nduration = true", ["[swarm] duration = true", "finite number > 0"]),
     ("[swarm]\nstatic_fraction = 1.5", ["[swarm] static_fraction = 1.5", "<= 1"]),
-    ("[swarm]\nstatic_fraction = 0.1\nstatic_time = 30", ["[swarm] static_time = 30.0", "duration = 20 s"]),
+    ("[swarm]\nstatic_fraction = 0.1\nstatic_time = 30",
+     ["[swarm] static_fraction = 0.1, static_time = 30.0: static_time is after the run ends at t = 20 s"]),
+    # the simulator's own check: 10.04 s is 100 steps of 0.1 s, so the run ends at t = 10 s
+    ("[swarm]\nduration = 10.04\nstatic_fraction = 0.3\nstatic_time = 10.04",
+     ["[swarm] duration = 10.04, static_fraction = 0.3, static_time = 10.04: static_time is after the run "
+      "ends at t = 10 s"]),
+    ("[swarm]\nduration = [30, 10]\nstatic_fraction = 0.5\nstatic_time = 20",
+     ["[swarm] duration = 10.0, static_fraction = 0.5, static_time = 20.0", "run ends at t = 10 s"]),
+    # integers must fit the store's 32-bit columns
+    ("[arena]\nholes = 99999999999999999", ["[arena] holes = 99999999999999999", "at most 2147483647"]),
+    ("[swarm]\nagents = [100, 2147483648]", ["[swarm] agents = 2147483648", "at most 2147483647"]),
+    ("[sweep]\nreplicates = 2147483648", ["[sweep] replicates = 2147483648", "at most 2147483647"]),
+    ("[sweep]\nreplicates = 500001\n[swarm]\nagents = [100, 200]",
+     ["[sweep] replicates = 500001", "2 grid points x 500,001 replicates = 1,000,002 jobs, more than the 1,000,000"]),
+    # MapConfig.validate's bounds, as `swarmtopo map`'s
+    ("[map]\nhop_cost = 1e15", ["[map] hop_cost = 1000000000000000.0: hop_cost must be a number of seconds "
+                                "in [0, 1e+09]"]),
+    ("[map]\nhop_cost = [0, 2e9]", ["[map] hop_cost = 2000000000.0: hop_cost must be"]),
+    ("[map]\nwall_follow_weight = 1e300", ["[map] wall_follow_weight = 1e+300: wall_follow_weight must be a "
+                                           "number in [0, 1e+06]"]),
+    ("[map]\nlandmarks = 100000", ["[map] landmarks = 100000: landmarks must be in 3..2000"]),
+    ("[map]\nmax_landmarks = 2001", ["[map] max_landmarks = 2001: max_landmarks must be in 3..2000"]),
+    (f"[map]\nwindow_scales = {list(range(1, 50))}", ["[map] window_scales = [1.0, 2.0,", "max_windows must be"]),
     ("[swarm]\nstatic_time = 3", ["[swarm] static_time", "static_fraction is 0"]),
     ("[map]\nlandmarks = 2", ["[map] landmarks = 2", '"auto"']),
     ("[map]\nmaxdim = 3", ["[map] maxdim = 3", "1..2"]),
@@ -223,6 +245,38 @@ def test_malformed_file_is_one_error_naming_file_key_and_value(tmp_path, body, f
     assert message.startswith(f"{path}: ") and "\n" not in message
     for fragment in fragments:
         assert fragment in message
+
+
+def test_every_integer_key_is_bounded_by_its_store_column(tmp_path):
+    integers = [p for p in PARAMS if p.sql == "INTEGER"]
+    assert {p.name for p in integers} == {"holes", "agents", "landmarks", "max_landmarks", "maxdim"}
+    for p in integers:
+        with pytest.raises(InputError, match=rf"^<grid>: \[{p.table}\] {p.name} = {STORE_INT_MAX + 1}: "):
+            expand_grid({p.table: {p.name: STORE_INT_MAX + 1}})
+    # the bound itself is stored (the job's row: holes that do not fit)
+    row = run_job(expand_grid({"arena": {"holes": STORE_INT_MAX}}).jobs[0])
+    assert row["error"].startswith(f"cannot place {STORE_INT_MAX} holes")
+    with ResultStore(tmp_path / "s.duckdb") as store:
+        assert store.insert(row)
+    assert [r["holes"] for r in read_jobs(tmp_path / "s.duckdb")] == [STORE_INT_MAX]
+
+
+@pytest.mark.parametrize("body, where", [
+    ("[arena]\nholes = 99999999999999999", "[arena] holes = 99999999999999999: "),
+    ("[map]\nhop_cost = 1e15", "[map] hop_cost = 1000000000000000.0: "),
+    ("[map]\nwall_follow_weight = 1e300", "[map] wall_follow_weight = 1e+300: "),
+    ("[map]\nlandmarks = 100000", "[map] landmarks = 100000: "),
+    ("[swarm]\nduration = 10.04\nstatic_fraction = 0.3\nstatic_time = 10.04",
+     "[swarm] duration = 10.04, static_fraction = 0.3, static_time = 10.04: "),
+])
+def test_cli_refuses_a_job_its_checks_would_fail_before_touching_the_store(tmp_path, body, where):
+    path = tmp_path / "bad.toml"
+    path.write_text(body + "\n")
+    proc = run_cli("sweep", path, "--store", tmp_path / "r.duckdb", "--workers", "1")
+    assert proc.returncode == 1 and "Traceback" not in proc.stderr
+    (line,) = proc.stderr.strip().splitlines()
+    assert line.startswith(f"error: {path}: {where}")
+    assert not (tmp_path / "r.duckdb").exists()
 
 
 def test_cli_bad_config_is_one_line_exit_1(tmp_path):

@@ -49,6 +49,9 @@ meeting say nothing about the arena)."""
 MAX_HOP_COST, MAX_WALL_FOLLOW_WEIGHT = 1e9, 1e6
 """Bounds of the per-hop cost (s, about 30 years) and of the wall-following charge (s/s):
 far beyond any log, and far below where squared distances overflow in MDS."""
+MAX_LANDMARKS = 2000
+"""Bound of ``MapConfig.landmarks`` and ``max_landmarks`` (``map --landmarks``'s too):
+persistence time grows about as L^3."""
 MAX_WINDOWS_LISTED = 100_000
 """Most windows of one length a log may be cut into before the cap picks its share."""
 AUTO_COVER_FACTOR = 1.5
@@ -183,13 +186,13 @@ class MapConfig:
         shipped ``default``: (1, 0.5); ``trace``: (1,); docs/accuracy.md); with
         another subsampler, (1,).
     landmarks
-        Number of landmarks L for the whole map, shared between regions in
+        Number of landmarks L (3 .. ``MAX_LANDMARKS``) for the whole map, shared between regions in
         proportion to their events.  None (default): per region, the fewest
         landmarks whose covering radius is at most ``AUTO_COVER_FACTOR`` times the
         region's k-NN scale, at most ``max_landmarks``; maxmin-type selection is
         greedy, so these are the first landmarks of a longer run.
     max_landmarks
-        Cap of the automatic landmark count per region and window (default 400, the
+        Cap of the automatic landmark count per region and window (3 .. ``MAX_LANDMARKS``; default 400, the
         setting the accuracy benchmark measured; persistence stays well under a
         second).
     window
@@ -255,10 +258,10 @@ class MapConfig:
         if self.subsample not in SUBSAMPLERS:
             raise SwarmtopoError(
                 f"unknown subsampler {self.subsample!r}; expected one of {', '.join(SUBSAMPLERS)}")
-        if self.landmarks is not None and self.landmarks < 3:
-            raise SwarmtopoError(f"landmarks must be at least 3, got {self.landmarks}")
-        if self.max_landmarks < 3:
-            raise SwarmtopoError(f"max_landmarks must be at least 3, got {self.max_landmarks}")
+        for name, count in (("landmarks", self.landmarks), ("max_landmarks", self.max_landmarks)):
+            if count is not None and not 3 <= count <= MAX_LANDMARKS:
+                raise SwarmtopoError(f"{name} must be in 3..{MAX_LANDMARKS} (persistence time grows about as L^3), "
+                                     f"got {count}")
         if self.hop_cost is not None and not (np.isfinite(self.hop_cost) and 0 <= self.hop_cost <= MAX_HOP_COST):
             raise SwarmtopoError(f"hop_cost must be a number of seconds in [0, {MAX_HOP_COST:g}], got {self.hop_cost}")
         if self.diffusion_time is not None and not self.diffusion_time > 0:
@@ -885,10 +888,12 @@ def _windows(event_t: np.ndarray, length: float, step: float | None = None) -> l
     if t_last - t_first <= length:
         return [None]
     step = length / 2 if step is None else step
-    n = 1 + int(np.ceil((t_last - t_first - length) / step - 1e-9))
-    if n > MAX_WINDOWS_LISTED:
+    count = 1 + np.ceil((t_last - t_first - length) / step - 1e-9)  # a float: inf for a length of 1e-320 s
+    if count > MAX_WINDOWS_LISTED:
         raise SwarmtopoError(f"windows of {length:.3g} s every {step:.3g} s over the log's {t_last - t_first:.6g} s "
-                             f"would be {n:,}, more than {MAX_WINDOWS_LISTED:,}: use longer windows")
+                             f"would be {f'{int(count):,}' if count < 1e12 else f'{count:.3g}'}, "
+                             f"more than {MAX_WINDOWS_LISTED:,}: use longer windows")
+    n = int(count)
     return [(float(s), float(s) + length) for s in np.linspace(t_first, t_last - length, n)]
 
 

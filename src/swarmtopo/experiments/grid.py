@@ -36,7 +36,7 @@ Format (``examples/sweep-small.toml`` is a commented example)::
     window_scales = [0.75, 1.0, 1.25]  # multipliers of the window length whose windows are all pooled
     window_step = "auto"      # s between window starts: a number > 0 or "auto" (half the length)
     subsample = "maxmin"      # maxmin | knn | probabilistic (default maxmin)
-    landmarks = "auto"        # an integer L >= 3, or "auto" (default)
+    landmarks = "auto"        # an integer L in 3..2000, or "auto" (default)
     max_landmarks = 400       # cap of the automatic count (only with landmarks = "auto")
     maxdim = 1                # highest homology dimension, 1 or 2 (default 1)
     classifier = "default"    # "default", "paper", or a classifier JSON file
@@ -55,10 +55,12 @@ Canonical configuration.  Each grid point becomes a nested dict ``{"arena": ...,
 and options use (``holes`` is dropped for ``generator = "default"``, ``static_time``
 when ``static_fraction = 0``, ``max_landmarks`` when ``landmarks`` is a number);
 points that become equal are one job.  A key given in the file that no grid point
-uses is an error.  Input files (``path``, a classifier path) enter the configuration
-as written plus the SHA-256 of their bytes, so a job is tied to the file's content;
-workers read them at their absolute path (on a cluster of several machines, keep them
-on a shared file system).
+uses is an error, and so is a point the job's own checks refuse (the simulator's,
+``MapConfig.validate``): every job is checked before any runs.  Integers must fit the
+store's 32-bit columns.  Input files (``path``, a classifier path) enter the
+configuration as written plus the SHA-256 of their bytes, so a job is tied to the
+file's content; workers read them at their absolute path (on a cluster of several
+machines, keep them on a shared file system).
 
 Job identity.  ``job.key`` is the SHA-256 (hex) of the canonical JSON of (config,
 replicate, salt); ``job.seed`` is the first 64 bits of the same hash.  Neither depends
@@ -87,7 +89,8 @@ from ..errors import InputError, SwarmtopoError
 from ..graph import METRICS
 from ..io import read_arena
 from ..landmarks import SUBSAMPLERS
-from ..pipeline import MapConfig
+from ..pipeline import MapConfig, seconds_option, wall_follow_option
+from ..sim.simulate import check_parameters
 
 GENERATORS: dict[str, tuple[str, ...]] = {
     "random": ("holes", "shapes", "outer", "scale"),
@@ -100,6 +103,8 @@ GENERATORS: dict[str, tuple[str, ...]] = {
 """Arena generators and the ``[arena]`` keys each one uses (besides ``generator``)."""
 STREAMS = ("arena", "simulation", "map")
 """The independent random streams of a job, in :meth:`Job.stream_seeds` order."""
+STORE_INT_MAX = int(np.iinfo(np.int32).max)
+"""Bound of every integer key: the store's INTEGER columns are 32-bit."""
 
 
 class _Bad(Exception):
@@ -107,10 +112,13 @@ class _Bad(Exception):
 
 
 # -- value checks: each returns the canonical value or raises _Bad --------------------------
-def _integer(lo: int, hi: int | None = None) -> Callable[[Any], int]:
+def _integer(lo: int, hi: int = STORE_INT_MAX) -> Callable[[Any], int]:
+    expected = (f"expected an integer in {lo}..{hi}" if hi < STORE_INT_MAX
+                else f"expected an integer >= {lo} (at most {hi}: a 32-bit store column)")
+
     def check(value):
-        if isinstance(value, bool) or not isinstance(value, int) or value < lo or (hi is not None and value > hi):
-            raise _Bad(f"expected an integer {'>= ' + str(lo) if hi is None else f'in {lo}..{hi}'}")
+        if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
+            raise _Bad(expected)
         return int(value)
     return check
 
@@ -226,6 +234,9 @@ PARAMS: tuple[Param, ...] = (
 """Every grid key, in expansion order (the last key varies fastest)."""
 GRID_TABLES = ("arena", "swarm", "map")
 SWEEP_KEYS = ("name", "replicates", "salt")
+MAX_JOBS = 1_000_000
+"""Most jobs a sweep may expand to (grid points x replicates): months of maps on one
+machine, and their Job objects still fit in memory."""
 
 
 @dataclass(frozen=True)
@@ -385,6 +396,10 @@ def expand_grid(document: dict, *, source: str = "<grid>", base_dir=None,
                 names = ", ".join(p.name for p in PARAMS if p.table == table)
                 fail(f"[{table}] {key}", f"unknown key; expected one of {names}")
     axes = [_axis(document.get(param.table, {}), param, fail) for param in PARAMS]
+    points = math.prod(len(axis) for axis in axes)
+    if points * replicates > MAX_JOBS:
+        fail(f"[sweep] replicates = {replicates}", f"{points:,} grid points x {replicates:,} replicates = "
+             f"{points * replicates:,} jobs, more than the {MAX_JOBS:,} a sweep may hold")
 
     inputs = _InputFiles(base_dir, fail)
     configs: dict[str, tuple[tuple[str, str], ...]] = {}
@@ -393,7 +408,10 @@ def expand_grid(document: dict, *, source: str = "<grid>", base_dir=None,
         point = {(p.table, p.name): v for p, v in zip(PARAMS, values)}
         config, files, keys = _canonical(point, inputs, fail)
         used |= keys
-        configs.setdefault(canonical_json(config), files)
+        text = canonical_json(config)
+        if text not in configs:
+            _check_job(config, document, fail)
+            configs[text] = files
     for table in GRID_TABLES:
         for key in document.get(table, {}):
             if (table, key) not in used:
@@ -415,6 +433,41 @@ def flat_columns(config: dict) -> dict[str, Any]:
         flat[p.name] = (float("inf") if value == "none" and p.sql == "DOUBLE"
                         else None if value in ("auto", "none") else value)
     return flat
+
+
+def job_simulation_args(swarm: dict[str, Any]) -> dict[str, Any]:
+    """The swarm arguments of :func:`~swarmtopo.sim.simulate` (besides arena and rng) of a
+    job's canonical ``[swarm]`` table."""
+    return {"n_agents": swarm["agents"], "duration": swarm["duration"],
+            "static_fraction": swarm["static_fraction"], "static_time": swarm.get("static_time", 0.0)}
+
+
+def job_map_config(mapping: dict[str, Any], seed: int | None = None) -> MapConfig:
+    """The ``MapConfig`` of a job's canonical ``[map]`` table ("auto" -> None, from the
+    data; "none" -> inf, except a "none" wall-following weight -> None), as sweeps map:
+    no picture, no loops; every other option is ``swarmtopo map``'s default, the window
+    cap ``max_windows`` included (not a grid key: no map of the accuracy suite reaches it), and
+    ``agreement`` ("auto" unless the table says, as the gate's fitting jobs do) and
+    ``landmark_bands`` (absent or "auto": the bands the job's classifier was fitted with)."""
+    return MapConfig(
+        metric=mapping["metric"], subsample=mapping["subsample"],
+        hop_cost=seconds_option(mapping["hop_cost"]),
+        diffusion_time=seconds_option(mapping["diffusion_time"]),
+        wall_follow_weight=wall_follow_option(mapping["wall_follow_weight"]),
+        window_length=seconds_option(mapping["window_length"]),
+        window_encounters=mapping.get("window_encounters", MapConfig.window_encounters),
+        window_scales=tuple(mapping.get("window_scales", MapConfig.window_scales)),
+        window_step=seconds_option(mapping.get("window_step")),
+        landmark_bands=landmark_bands_option(mapping.get("landmark_bands", "auto")),
+        landmarks=None if mapping["landmarks"] == "auto" else mapping["landmarks"],
+        max_landmarks=mapping.get("max_landmarks", MapConfig.max_landmarks),
+        maxdim=mapping["maxdim"], seed=seed, embed_dim=0, cycles=False,
+        agreement=mapping.get("agreement", MapConfig.agreement))
+
+
+def landmark_bands_option(value) -> tuple[float, ...] | None:
+    """A ``[map]`` table's ``landmark_bands``: "auto" -> None (the classifier's own), else the bands."""
+    return None if value == "auto" else tuple(value)
 
 
 # -- internals ----------------------------------------------------------------------------
@@ -487,9 +540,6 @@ def _canonical(point: dict, inputs: _InputFiles, fail):
     swarm = {name: point[("swarm", name)] for name in ("agents", "duration", "static_fraction")}
     if swarm["static_fraction"] > 0:
         swarm["static_time"] = point[("swarm", "static_time")]
-        if swarm["static_time"] > swarm["duration"]:
-            fail(f"[swarm] static_time = {_toml(swarm['static_time'])}",
-                 f"after the end of the run (duration = {swarm['duration']:g} s)")
 
     mapping = {name: point[("map", name)]
                for name in ("metric", "hop_cost", "diffusion_time", "wall_follow_weight", "window_length",
@@ -511,6 +561,21 @@ def _canonical(point: dict, inputs: _InputFiles, fail):
     config = {"arena": arena, "swarm": swarm, "map": mapping}
     used = {(table, key) for table, body in config.items() for key in body}
     return config, tuple(files), used
+
+
+def _check_job(config: dict, document: dict, fail) -> None:
+    """The job's own checks of its configuration, before any job runs: the simulator's
+    (:func:`job_simulation_args`) and the map's (:func:`job_map_config`); a failure names
+    the table's keys given in the file, with this job's values."""
+    checks = {"swarm": lambda: check_parameters(**job_simulation_args(config["swarm"])),
+              "map": lambda: job_map_config(config["map"]).validate()}
+    for table, check in checks.items():
+        try:
+            check()
+        except SwarmtopoError as exc:
+            body = config[table]
+            given = ", ".join(f"{key} = {_toml(body[key])}" for key in document.get(table, {}) if key in body)
+            fail(f"[{table}] {given}".rstrip(), exc.reason if isinstance(exc, InputError) else str(exc))
 
 
 def _unused_reason(table: str, key: str, document: dict) -> str:

@@ -37,10 +37,9 @@ from ..errors import SwarmtopoError
 from ..io import GROUND_TRUTH_META_KEYS, read_arena, read_log, write_log
 from ..log import EncounterLog
 from ..persistence import snr
-from ..pipeline import (MapConfig, agreement_json, map_encounters, seconds_option, software_versions,
-                        wall_follow_option)
+from ..pipeline import agreement_json, map_encounters, software_versions
 from ..sim import simulate
-from .grid import Job, flat_columns
+from .grid import Job, flat_columns, job_map_config, job_simulation_args
 from .store import JOB_COLUMNS, ResultStore
 
 WORKER_WAIT = 120.0
@@ -124,40 +123,12 @@ def map_input(mapping: dict[str, Any]) -> str:
     return source
 
 
-def job_map_config(mapping: dict[str, Any], seed: int | None = None) -> MapConfig:
-    """The ``MapConfig`` of a job's canonical ``[map]`` table ("auto" -> None, from the
-    data; "none" -> inf, except a "none" wall-following weight -> None), as sweeps map:
-    no picture, no loops; every other option is ``swarmtopo map``'s default, the window
-    cap ``max_windows`` included (not a grid key: no map of the accuracy suite reaches it), and
-    ``agreement`` ("auto" unless the table says, as the gate's fitting jobs do) and
-    ``landmark_bands`` (absent or "auto": the bands the job's classifier was fitted with)."""
-    return MapConfig(
-        metric=mapping["metric"], subsample=mapping["subsample"],
-        hop_cost=seconds_option(mapping["hop_cost"]),
-        diffusion_time=seconds_option(mapping["diffusion_time"]),
-        wall_follow_weight=wall_follow_option(mapping["wall_follow_weight"]),
-        window_length=seconds_option(mapping["window_length"]),
-        window_encounters=mapping.get("window_encounters", MapConfig.window_encounters),
-        window_scales=tuple(mapping.get("window_scales", MapConfig.window_scales)),
-        window_step=seconds_option(mapping.get("window_step")),
-        landmark_bands=landmark_bands_option(mapping.get("landmark_bands", "auto")),
-        landmarks=None if mapping["landmarks"] == "auto" else mapping["landmarks"],
-        max_landmarks=mapping.get("max_landmarks", MapConfig.max_landmarks),
-        maxdim=mapping["maxdim"], seed=seed, embed_dim=0, cycles=False,
-        agreement=mapping.get("agreement", MapConfig.agreement))
-
-
 def job_classifier(mapping: dict[str, Any]) -> str:
     """The classifier a job's map is read with: its ``[map]`` table's, "default" being
     ``map``'s own for what the job reads (:func:`~swarmtopo.pipeline.shipped_classifier_for`:
     ``trace`` for a contact trace; a simulated log always has status rows)."""
     name = mapping["classifier"]
     return "trace" if name == "default" and map_input(mapping) == "contact-trace" else name
-
-
-def landmark_bands_option(value) -> tuple[float, ...] | None:
-    """A ``[map]`` table's ``landmark_bands``: "auto" -> None (the classifier's own), else the bands."""
-    return None if value == "auto" else tuple(value)
 
 
 def run_job(job: Job) -> dict[str, Any]:
@@ -188,8 +159,7 @@ def run_job(job: Job) -> dict[str, Any]:
         arena = build_arena(config["arena"], seeds["arena"], job.file("arena.path"))
         row["true_betti0"], row["true_betti1"] = arena.betti
         t0 = time.perf_counter()
-        sim = simulate(arena, swarm["agents"], swarm["duration"], static_fraction=swarm["static_fraction"],
-                       static_time=swarm.get("static_time", 0.0), rng=seeds["simulation"])
+        sim = simulate(arena, **job_simulation_args(swarm), rng=seeds["simulation"])
         row["t_simulate"] = time.perf_counter() - t0
         row["n_events"], row["n_agents"] = sim.log.n_events, sim.log.n_agents
         log = stripped_log(sim.log)

@@ -8,7 +8,9 @@ ground truth.  Parameters and project choices: :mod:`.params`.
 
 from .params import BEHAVIOURS, Command, MotionParams, SensingParams
 from .sensing import EncounterTracker
-from .simulate import Simulation, check_time_step, interpreted_kernels, simulate
+from .simulate import (MAX_AGENTS, Simulation, check_run_size, check_static_time, check_time_step, interpreted_kernels,
+                       simulate)
 
-__all__ = ["BEHAVIOURS", "Command", "EncounterTracker", "MotionParams", "SensingParams", "Simulation",
-           "check_time_step", "interpreted_kernels", "simulate"]
+__all__ = ["BEHAVIOURS", "MAX_AGENTS", "Command", "EncounterTracker", "MotionParams",
+           "SensingParams", "Simulation", "check_run_size", "check_static_time", "check_time_step",
+           "interpreted_kernels", "simulate"]

@@ -39,6 +39,13 @@ from . import walls as _walls
 from .params import STATIC, Command, MotionParams, SensingParams
 
 TIME_DECIMALS = 9
+MAX_AGENTS = 100_000
+"""Most agents a run may have: 500 times the demo's swarm."""
+MAX_AGENT_STEPS = 1e10
+"""Most agent-steps (agents x duration / dt) a run may take: 10,000 times the accuracy
+benchmark's largest run (800 agents x 120 s at dt = 0.1 s), hours of computing."""
+DT = 0.1
+"""Default time step of :func:`simulate`, s."""
 
 
 @dataclass
@@ -71,7 +78,7 @@ def simulate(
     n_agents: int = 200,
     duration: float = 20.0,
     *,
-    dt: float = 0.1,
+    dt: float = DT,
     motion: MotionParams = MotionParams(),
     sensing: SensingParams = SensingParams(),
     commands: Sequence[Command] = (),
@@ -194,6 +201,20 @@ def _check_inputs(arena, n_agents, duration, dt, motion, sensing, commands, stat
                   trajectory_every, progress) -> None:
     if not isinstance(arena, Arena):
         raise InputError(f"arena must be a swarmtopo Arena, got {type(arena).__name__}")
+    check_parameters(n_agents, duration, dt=dt, motion=motion, sensing=sensing, commands=commands,
+                     static_fraction=static_fraction, static_time=static_time)
+    if trajectory_every is not None:
+        positive("trajectory_every", trajectory_every)
+    if progress is not None and not callable(progress):
+        raise InputError("progress must be callable or None", value=progress)
+
+
+def check_parameters(n_agents: int, duration: float, *, dt: float = DT,
+                     motion: MotionParams = MotionParams(), sensing: SensingParams = SensingParams(),
+                     commands: Sequence[Command] = (), static_fraction: float = 0.0,
+                     static_time: float = 0.0) -> None:
+    """:func:`simulate`'s checks of the swarm's parameters (all but the arena, rng and
+    outputs), without running it: InputError on a bad one."""
     positive_int("n_agents", n_agents)
     if not isinstance(motion, MotionParams):
         raise InputError(f"motion must be a MotionParams, got {type(motion).__name__}")
@@ -201,24 +222,19 @@ def _check_inputs(arena, n_agents, duration, dt, motion, sensing, commands, stat
         raise InputError(f"sensing must be a SensingParams, got {type(sensing).__name__}")
     check_time_step(dt, motion, sensing)
     non_negative("duration", duration)
+    check_run_size(n_agents, duration, dt)
     non_negative("static_time", static_time)
     fraction("static_fraction", static_fraction)
     for c in commands:
         if not isinstance(c, Command):
             raise InputError(f"commands must be Command objects, got {type(c).__name__}", value=c)
     _commands.check_command_agents(commands, int(n_agents))
+    check_static_time(static_fraction, static_time, duration, dt)
     end = _end_time(duration, dt)
-    if static_fraction > 0 and round(static_time, TIME_DECIMALS) > end:
-        raise InputError(f"static_time is after the run ends at t = {end:g} s, so no agent would become static",
-                         value=static_time)
     for c in commands:
         if round(c.time, TIME_DECIMALS) > end:
             raise InputError(f"command {c.behaviour!r} at t = {c.time:g} s comes after the run ends at "
                              f"t = {end:g} s", value=c.time)
-    if trajectory_every is not None:
-        positive("trajectory_every", trajectory_every)
-    if progress is not None and not callable(progress):
-        raise InputError("progress must be callable or None", value=progress)
 
 
 def check_time_step(dt: float, motion: MotionParams, sensing: SensingParams) -> None:
@@ -231,6 +247,24 @@ def check_time_step(dt: float, motion: MotionParams, sensing: SensingParams) -> 
             f"time step too coarse: agents move max(v_c, v_p) * dt = {speed * dt:g} mm per step, more than "
             f"r_d / 4 = {sensing.r_d / 4:g} mm, so contacts and walls could be stepped over; "
             f"use dt <= {sensing.r_d / (4 * speed):g} s", value=dt)
+
+
+def check_run_size(n_agents: int, duration: float, dt: float) -> None:
+    """InputError unless the run has at most MAX_AGENTS agents and MAX_AGENT_STEPS agent-steps."""
+    if n_agents > MAX_AGENTS:
+        raise InputError(f"n_agents must be at most {MAX_AGENTS:,}", value=n_agents)
+    steps = n_agents * (duration / dt)
+    if steps > MAX_AGENT_STEPS:
+        raise InputError(f"{n_agents} agents x {duration:.3g} s / dt {dt:.3g} s = {steps:.3g} agent-steps, more than "
+                         f"the {MAX_AGENT_STEPS:.0e} a run may take")
+
+
+def check_static_time(static_fraction: float, static_time: float, duration: float, dt: float) -> None:
+    """InputError if agents are to become static after the run's last step t_K."""
+    end = _end_time(duration, dt)
+    if static_fraction > 0 and round(static_time, TIME_DECIMALS) > end:
+        raise InputError(f"static_time is after the run ends at t = {end:g} s, so no agent would become static",
+                         value=static_time)
 
 
 def _n_steps(duration: float, dt: float) -> int:
