@@ -3,6 +3,7 @@
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -93,8 +94,15 @@ def test_map_never_reads_ground_truth(tmp_path, simulated):
 
 
 def test_demo_prints_recovered_and_true_betti_numbers(tmp_path):
+    # a log an earlier demo wrote is replaced, its outdated files removed (running demo twice works)
+    earlier = tmp_path / "demo" / "log"
+    assert run("simulate", "--agents", 20, "--duration", 1, "--format", "parquet", "--out", earlier, "-q").returncode == 0
+    meta = json.loads((earlier / "meta.json").read_text())
+    (earlier / "meta.json").write_text(json.dumps({**meta, "written_by": "swarmtopo demo"}))
     proc = run("demo", "--out", tmp_path / "demo")
     assert proc.returncode == 0, proc.stderr
+    assert not (earlier / "events.parquet").exists() and read_log(earlier).n_agents == 200
+    assert json.loads((earlier / "meta.json").read_text())["written_by"] == "swarmtopo demo"
     doc = json.loads((tmp_path / "demo" / "map.json").read_text())
     # the verdict is map.json's, with each Betti number's confidence in percent
     b1, c0, c1 = doc["betti"]["1"], doc["confidence"]["0"], doc["confidence"]["1"]
@@ -105,6 +113,18 @@ def test_demo_prints_recovered_and_true_betti_numbers(tmp_path):
     # the report carries the swarm animation from the demo's sampled trajectories
     html = (tmp_path / "demo" / "report.html").read_text(encoding="utf-8")
     assert "The swarm" in html and '"frames"' in html
+
+
+def test_demo_never_replaces_a_log_it_did_not_write(tmp_path):
+    folder = tmp_path / "d"
+    log = folder / "log"
+    assert run("simulate", "--agents", 20, "--duration", 1, "--format", "parquet", "--truth", "--out", log,
+               "-q").returncode == 0
+    before = {p.name: p.read_bytes() for p in log.iterdir()}
+    assert_one_line_error(run("demo", "--out", folder), f"{log}: already holds a log that swarmtopo demo did not write",
+                          "events.parquet", "choose another --out")
+    assert {p.name: p.read_bytes() for p in log.iterdir()} == before
+    assert sorted(p.name for p in folder.iterdir()) == ["log"]
 
 
 def test_bad_events_file_is_one_line_naming_file_row_column_value(tmp_path):
@@ -199,6 +219,68 @@ def test_option_values_that_do_not_fit_name_the_option(tmp_path):
     proc = run("ingest", trace, "--format", "csv", "--time-column", "t", "--a-column", "id1", "--b-column", "id2",
                "--out", out)
     assert proc.returncode == 0 and read_log(out).n_events == 2
+
+
+def test_runs_too_big_are_refused_naming_the_options(tmp_path):
+    out = tmp_path / "big"
+    for command in (["plan", "--area", 250000, "--duration", 30], ["simulate", "--duration", 1, "--out", out]):
+        for agents in (99999999999999999999999, 100001):
+            assert_one_line_error(run(*command, "--agents", agents), "'--agents'",
+                                  f"{'1.00e+23' if agents > 10**6 else '100,001'} is more than 100,000 agents",
+                                  code=2)
+    for option, value, steps in (("--duration", 1e300, "2e+303"), ("--dt", 1e-9, "4e+12")):
+        assert_one_line_error(run("simulate", option, value, "--out", out), "--agents, --duration, --dt",
+                              f"= {steps} agent-steps, more than the 1e+10 a run may take", code=2)
+    assert not out.exists()
+
+
+def test_the_limits_the_cli_states_without_importing_them_are_the_librarys():
+    """The CLI keeps its start-up light by stating these limits in its own code and help."""
+    from swarmtopo import cli
+    from swarmtopo.pipeline import MAX_LANDMARKS
+    from swarmtopo.sim.simulate import MAX_AGENT_STEPS, MAX_AGENTS
+
+    assert cli.MAX_LANDMARKS_OPTION == MAX_LANDMARKS
+    source = Path(cli.__file__).read_text()
+    assert f"at most {MAX_AGENTS:,}; agents x duration / dt at most {MAX_AGENT_STEPS:.0e}".replace("e+", "e") in source
+
+
+def test_simulate_scales_a_file_arena_and_refuses_holes_with_it(tmp_path):
+    from swarmtopo.io import read_arena
+
+    path = tmp_path / "arena.geojson"
+    path.write_text(json.dumps({"type": "Polygon", "coordinates": [
+        [[0, 0], [300, 0], [300, 200], [0, 200], [0, 0]], [[100, 50], [200, 50], [200, 150], [100, 150], [100, 50]]]}))
+    assert_one_line_error(run("simulate", "--arena", path, "--holes", 3, "--out", tmp_path / "h"), "--holes",
+                          "has its own holes", code=2)
+    assert not (tmp_path / "h").exists()
+    proc = run("simulate", "--arena", path, "--scale", 2, "--agents", 20, "--duration", 1, "--out", tmp_path / "s")
+    assert proc.returncode == 0, proc.stderr
+    arena = read_arena(tmp_path / "s" / "arena.geojson")
+    assert arena.bounds == (0, 0, 600, 400) and arena.area == 4 * (300 * 200 - 100 * 100) and arena.betti == (1, 1)
+
+
+def test_simulate_summary_says_the_time_simulated(tmp_path):
+    for duration, dt, simulated in ((10, 0.3, 9.9), (0.04, 0.1, 0.0)):
+        out = tmp_path / f"d{duration}"
+        proc = run("simulate", "--agents", 10, "--duration", duration, "--dt", dt, "--out", out)
+        assert proc.returncode == 0, proc.stderr
+        assert json.loads((out / "meta.json").read_text())["duration"] == simulated
+        assert f" agents over {simulated:g} s in an arena" in proc.stdout
+
+
+def test_option_values_out_of_range_name_the_option_in_short(tmp_path):
+    out = tmp_path / "o"
+    for value in ("inf", "1e300", "nan"):
+        assert_one_line_error(run("simulate", "--scale", value, "--out", out), "'--scale'", code=2)
+    assert_one_line_error(run("simulate", "--static-time", 10.04, "--static-fraction", 0.5, "--duration", 10,
+                              "--out", out), "--static-time", "after the run ends at t = 10 s", "(got 10.04)", code=2)
+    assert_one_line_error(run("simulate", "--static-time", "inf", "--static-fraction", 0.5, "--out", out),
+                          "'--static-time'", "inf is not a finite number", code=2)
+    assert not out.exists()
+    proc = run("map", tmp_path, "--window-scales", "1,1e-300")
+    assert_one_line_error(proc, "'--window-scales'", "each at least 0.05", code=2)
+    assert len(proc.stderr) < 200
 
 
 def test_simulate_replaces_a_log_only_with_overwrite(tmp_path):

@@ -32,6 +32,12 @@ MAX_LANDMARKS_OPTION = 2000
 """Most landmarks --landmarks may ask for per window (800 took about 1 GB and 80 s per window on a trace)."""
 DEMO_AGENTS, DEMO_SECONDS = 200, 30.0
 """The demo's swarm: the accuracy benchmark's smallest budget."""
+DEMO_WRITER = "swarmtopo demo"
+"""``written_by`` in the meta.json of the demo's log: the only log demo may replace."""
+MAX_SCALE = 1000.0
+"""Largest --scale: a 500 m square random arena, beyond what the wall grid accepts at r_d = 30 mm."""
+MIN_WINDOW_SCALE = 0.05
+"""Least --window-scales multiplier: windows of one encounter per agent at the automatic length."""
 VERBOSE_HELP = "Also report each stage's details and timings on stderr (in pipes too)."
 
 
@@ -80,6 +86,29 @@ def _finite_option(value: float | None) -> float | None:
     return value
 
 
+def _agents_option(value: int | None) -> int | None:
+    """A swarm size of at most ``sim.MAX_AGENTS`` (None passes)."""
+    from decimal import Decimal
+
+    from .sim import MAX_AGENTS
+
+    if value is not None and value > MAX_AGENTS:
+        shown = f"{value:,}" if value < 10**15 else f"{Decimal(value):.3g}"
+        raise typer.BadParameter(f"{shown} is more than {MAX_AGENTS:,} agents")
+    return value
+
+
+def _check_option(hint: str, check, *args) -> None:
+    """Run a simulator check; its InputError becomes a usage error naming ``hint``."""
+    from .errors import InputError
+
+    try:
+        check(*args)
+    except InputError as exc:
+        got = "" if exc.value is None else f" (got {exc.value:g})"
+        raise typer.BadParameter(exc.reason + got, param_hint=hint) from None
+
+
 def _accuracy_option(value: float | None) -> float | None:
     """A probability strictly between 0 and 1 (None passes)."""
     if value is not None and not 0 < value < 1:
@@ -109,14 +138,18 @@ def _progress(description: str, quiet: bool):
 def simulate(
     out_dir: Path = typer.Option(..., "--out", help="Folder to write the log into (created)."),
     arena: Optional[Path] = typer.Option(None, "--arena", help="Arena as GeoJSON Polygon/MultiPolygon in mm."),
-    holes: int = typer.Option(1, "--holes", min=0, help="Without --arena: square holes of a random square arena."),
-    scale: float = typer.Option(1.0, "--scale", min=0.05, help="Without --arena: scale of the random arena."),
-    agents: int = typer.Option(200, "--agents", min=1, help="Swarm size N."),
+    holes: Optional[int] = typer.Option(None, "--holes", min=0,
+                                        help="Square holes of a random square arena (default 1; not with --arena)."),
+    scale: float = typer.Option(1.0, "--scale", min=0.05, max=MAX_SCALE, callback=_finite_option,
+                                help="Scale factor of every length of the arena (random or --arena)."),
+    agents: int = typer.Option(200, "--agents", min=1, callback=_agents_option,
+                               help="Swarm size N (at most 100,000; agents x duration / dt at most 1e10)."),
     duration: float = typer.Option(20.0, "--duration", min=0.0, callback=_finite_option, help="Seconds of data."),
     seed: int = typer.Option(0, "--seed", min=0, help="Random seed (same seed, same bytes)."),
     static_fraction: float = typer.Option(0.0, "--static-fraction", min=0.0, max=1.0,
                                           help="Hybrid network: fraction of agents stopped for good."),
-    static_time: float = typer.Option(0.0, "--static-time", min=0.0, help="When the static agents stop (s)."),
+    static_time: float = typer.Option(0.0, "--static-time", min=0.0, callback=_finite_option,
+                                      help="When the static agents stop (s)."),
     dt: float = typer.Option(0.1, "--dt", callback=_positive_option, help="Time step (s); v_c*dt must stay <= r_d/4."),
     rd: float = typer.Option(30.0, "--rd", callback=_positive_option, help="Detection radius r_d (mm)."),
     truth: bool = typer.Option(False, "--truth", help="Also write truth.<fmt>: true positions per event."),
@@ -132,19 +165,23 @@ def simulate(
 
     from .arena import random_arena
     from .io import read_arena
-    from .errors import InputError
-    from .sim import MotionParams, SensingParams, check_time_step, simulate as run
+    from .sim import (MotionParams, SensingParams, check_run_size, check_static_time, check_time_step,
+                      simulate as run)
 
     _check_verbosity(quiet, verbose)
+    if arena is not None and holes is not None:
+        raise typer.BadParameter("an --arena file has its own holes; drop --holes or --arena", param_hint="--holes")
     if static_time > 0 and static_fraction == 0:
         raise typer.BadParameter("the static agents' stop time needs --static-fraction > 0", param_hint="--static-time")
-    try:
-        check_time_step(dt, MotionParams(), SensingParams(r_d=rd))  # the motion simulate runs with
-    except InputError as exc:
-        raise typer.BadParameter(exc.reason, param_hint="--dt") from None
+    _check_option("--dt", check_time_step, dt, MotionParams(), SensingParams(r_d=rd))  # the motion simulate runs with
+    _check_option("--agents, --duration, --dt", check_run_size, agents, duration, dt)
+    _check_option("--static-time", check_static_time, static_fraction, static_time, duration, dt)
 
-    # The arena draws from its own stream, spawned from the seed; the swarm uses the seed.
-    world = read_arena(arena) if arena else random_arena(holes, scale=scale, rng=np.random.SeedSequence(seed).spawn(1)[0])
+    if arena:  # scaled like a sweep's file arena
+        world = read_arena(arena) if scale == 1.0 else read_arena(arena).scaled(scale)
+    else:  # the arena draws from its own stream, spawned from the seed; the swarm uses the seed
+        world = random_arena(1 if holes is None else holes, scale=scale,
+                             rng=np.random.SeedSequence(seed).spawn(1)[0])
     for passage in world.narrow_passages(rd):
         _warn(f"{passage}, less than r_d = {rd:g} mm: the swarm may not tell them apart, and the map may miss "
               f"that hole", quiet)
@@ -163,7 +200,7 @@ def simulate(
                                 trajectories=sim.trajectories, arena=world)
     if not quiet:
         b0, b1 = world.betti
-        out.print(f"{sim.log.n_events} encounters of {agents} agents over {duration:g} s "
+        out.print(f"{sim.log.n_events} encounters of {agents} agents over {sim.log.meta['duration']:g} s "
                   f"in an arena with {b0} region(s) and {b1} hole(s)")
         out.print(f"wrote {', '.join(str(p) for p in written)}")
 
@@ -295,8 +332,9 @@ def _parse_scales(text: Optional[str]):
     if text is None:
         return None
     scales = _distinct_numbers(text, "0.75,1,1.25")
-    if not all(math.isfinite(x) and x > 0 for x in scales):
-        raise typer.BadParameter(f"{text!r}: the scales must be distinct positive numbers")
+    if not all(math.isfinite(x) and x >= MIN_WINDOW_SCALE for x in scales):
+        raise typer.BadParameter(f"{text!r}: the scales must be distinct positive numbers, each at least "
+                                 f"{MIN_WINDOW_SCALE:g}")
     return scales
 
 
@@ -357,8 +395,9 @@ def map_command(
              "(default) holds about 20 encounters per agent (20 x the mean time between an agent's encounters)."),
     window_scales: Optional[str] = typer.Option(
         None, "--window-scales", callback=_parse_scales,
-        help="Comma-separated multipliers of the window length: the windows of every such length are pooled "
-             "together (default: 0.75,1,1.25; 1 maps one length, about three times faster: docs/accuracy.md)."),
+        help="Comma-separated multipliers of the window length, each at least 0.05: the windows of every such "
+             "length are pooled together (default: 0.75,1,1.25; 1 maps one length, about three times faster: "
+             "docs/accuracy.md)."),
     landmark_bands: Optional[str] = typer.Option(
         None, "--landmark-bands", callback=_parse_bands,
         help="Comma-separated shares of each window's length: every window is mapped once per share B, its "
@@ -431,7 +470,8 @@ def map_command(
 
 @app.command(epilog="Example: swarmtopo demo --out swarmtopo-demo")
 def demo(
-    out_dir: Path = typer.Option(Path("swarmtopo-demo"), "--out", help="Output folder."),
+    out_dir: Path = typer.Option(Path("swarmtopo-demo"), "--out",
+                                 help="Output folder (a log already in its log/ is replaced only if demo wrote it)."),
     seed: int = typer.Option(0, "--seed", min=0, help="Random seed."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
@@ -443,15 +483,20 @@ def demo(
     Betti numbers beside the true ones and where the figures were written.
     """
     from .arena import default_arena
-    from .io import write_log
+    from .io import log_files, write_log
     from .pipeline import MapConfig
     from .sim import simulate as run
 
     _check_verbosity(quiet, verbose)
+    log_dir = out_dir / "log"
+    foreign = [] if _demo_wrote(log_dir) else log_files(log_dir)
+    if foreign:
+        raise SwarmtopoError(f"{log_dir}: already holds a log that swarmtopo demo did not write "
+                             f"({', '.join(p.name for p in foreign)}); choose another --out")
     world = default_arena()
     with _progress("simulating", quiet) as tick:
         sim = run(world, DEMO_AGENTS, DEMO_SECONDS, rng=seed, truth=True, trajectory_every=0.5, progress=tick)
-    log_dir = out_dir / "log"
+    sim.log.meta["written_by"] = DEMO_WRITER
     write_log(sim.log, log_dir, truth=sim.truth, trajectories=sim.trajectories, arena=world)
     if verbose:
         _detail(f"simulated: {sim.log.n_events} encounters of {DEMO_AGENTS} agents over {DEMO_SECONDS:g} s; "
@@ -462,6 +507,18 @@ def demo(
         _print_verdict(tmap, truth=world.betti)
         out.print(f"log: {log_dir}")
         out.print(f"wrote {', '.join(str(p) for p in written)}")
+
+
+def _demo_wrote(log_dir: Path) -> bool:
+    """Whether ``log_dir``'s meta.json says ``swarmtopo demo`` wrote the log (so it may replace it)."""
+    from .io import read_json
+
+    meta = log_dir / "meta.json"
+    try:
+        doc = read_json(meta) if meta.is_file() else None
+    except SwarmtopoError:  # unreadable: not provably the demo's
+        return False
+    return isinstance(doc, dict) and doc.get("written_by") == DEMO_WRITER
 
 
 @app.command(epilog="Example: swarmtopo sweep examples/sweep-small.toml --store results.duckdb --workers 2  "
@@ -647,7 +704,8 @@ def bench_accuracy(
                     "swarmtopo plan --area 250000 --agents 200 --target 0.95 --holes 3")
 def plan(
     area: float = typer.Option(..., "--area", callback=_positive_option, help="Area inside the outer walls, mm^2."),
-    agents: Optional[int] = typer.Option(None, "--agents", min=1, help="Swarm size N."),
+    agents: Optional[int] = typer.Option(None, "--agents", min=1, callback=_agents_option,
+                                         help="Swarm size N (at most 100,000)."),
     duration: Optional[float] = typer.Option(None, "--duration", callback=_positive_option, help="Seconds of data T."),
     target: Optional[float] = typer.Option(None, "--target", callback=_accuracy_option,
                                            help="Wanted exact-match accuracy, e.g. 0.95."),
