@@ -328,6 +328,29 @@ def test_parquet_nulls_and_nan_ids_are_missing_values_and_text_is_kept_exactly(t
     assert events(log) == [(1.0, " 1", "2"), (2.0, "1 ", "2")]
 
 
+@pytest.mark.parametrize("ids", [["B7", "B7 ", "B8"], ["B12  ", "B13  ", "B1   "]])
+def test_padded_parquet_ids_survive_a_csv_log_folder(tmp_path, ids):
+    path = tmp_path / "trace.parquet"
+    pq.write_table(pa.table({"t": [0.0, 1.0, 2.0], "a": [ids[0], ids[1], ids[0]], "b": [ids[1], ids[2], ids[2]]}), path)
+    log, _ = ingest(path, "parquet")
+    write_log(log, tmp_path / "log", fmt="csv")
+    back = read_log(tmp_path / "log")
+    assert events(back) == events(log) == [(0.0, *sorted(ids[:2])), (1.0, *sorted(ids[1:])),
+                                           (2.0, *sorted((ids[0], ids[2])))]
+
+
+def test_csv_ids_differing_only_in_blanks_are_refused_not_merged(tmp_path):
+    path = write(tmp_path, "trace.csv", "t,a,b\n0,B7,B8\n\n1,B8,B9\n2,B9,B7 \n")
+    with pytest.raises(InputError, match="only in the blanks around it") as caught:
+        ingest(path, "csv")
+    assert (caught.value.row, caught.value.column, caught.value.value) == (4, "b", "B7 ")
+    # blanks round integer IDs, or round every spelling of a text ID alike, are dropped
+    log, _ = ingest(write(tmp_path, "ints.csv", "t, a, b\n0, 5, 6\n1,6,7\n"), "csv")
+    assert log.agent_ids.tolist() == [5, 6, 7]
+    log, _ = ingest(write(tmp_path, "text.csv", "t, a, b\n0, p1, p2\n1, p2, p3\n"), "csv")
+    assert log.agent_ids.tolist() == ["p1", "p2", "p3"]
+
+
 def test_duplicate_events_quote_both_file_rows_and_the_exact_time(tmp_path):
     path = write(tmp_path, "trace.csv", "t,a,b\n5,7,8\n\n6,x,x\n1400028780,1,2\n1400028780,2,1\n")
     with pytest.raises(InputError) as caught:

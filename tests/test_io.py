@@ -3,6 +3,7 @@
 import gzip
 import json
 import time
+import warnings
 from dataclasses import replace
 from pathlib import Path
 
@@ -228,12 +229,17 @@ def read_error(path) -> InputError:
 @pytest.mark.parametrize("events, row, column, value, reason", [
     ("t,a,b\n0,1,2\nabc,2,3\n", 2, "t", "abc", "time is not a number"),
     ("t,a,b\n0,1,2\n1,2,3\n2,3,4\n0x5,1,3\n", 4, "t", "0x5", "time is not a number"),
-    ("t,a,b\n0,1,2\nNaN,2,3\n", 2, "t", "nan", "finite"),
-    ("t,a,b\n0,1,2\n1,2,3\n-2,3,4\n", 3, "t", -2.0, "negative"),
+    ("t,a,b\n0,1,2\nNaN,2,3\n", 2, "t", "NaN", "finite"),
+    ("t,a,b\n0,1,2\n1,2,3\n-2,3,4\n", 3, "t", "-2", "negative"),
+    ("t,a,b\n0,1,2\n1e16,2,3\n", 2, "t", "1e16", "2^53"),
     ("t,a,b\n0,1,2\n,2,3\n", 2, "t", "", "time is missing"),
-    ("t,a,b\n0,1,2\n1,2,2\n", 2, "b", 2, "itself"),
+    ("t,a,b\n0,1,2\n1,2,2.0\n", 2, "b", "2.0", "itself"),
     ("t,a,b\n0,x,y\n1,,y\n", 2, "a", "", "agent ID is missing"),
     ("t,a,b\n0,x,y\n1,y,x\n0,y,x\n", 3, None, None, "duplicate event: same time and pair as row 1"),
+    # blank lines are rows, numbered as ingest numbers them; values are quoted as written
+    ("t,a,b\n0,1,2\n\n\n\n1,2,3\n-1,3,2\n", 6, "t", "-1", "negative"),
+    ("t,a,b\n\n0,1,2\n\nabc,2,3\n", 4, "t", "abc", "time is not a number"),
+    ("t,a,b\n\n0,x,y\n\n1,y,x\n0,y,x\n", 5, None, None, "duplicate event: same time and pair as row 2"),
 ])
 def test_bad_events_are_located(tmp_path, events, row, column, value, reason):
     err = read_error(folder(tmp_path, events))
@@ -242,9 +248,7 @@ def test_bad_events_are_located(tmp_path, events, row, column, value, reason):
     assert reason in str(err)
     if column is not None:
         assert err.column == column
-    if value == "nan":
-        assert np.isnan(err.value)
-    elif value is not None:
+    if value is not None:
         assert err.value == value
 
 
@@ -264,7 +268,7 @@ def test_unknown_state_and_undeclared_id(tmp_path):
     second = tmp_path / "second"
     second.mkdir()
     err = read_error(folder(second, "t,a,b\n0,0,1\n1,1,5\n", meta='{"agent_count": 3}'))
-    assert (err.file, err.row, err.column, err.value) == (str(second / "events.csv"), 2, "b", 5)
+    assert (err.file, err.row, err.column, err.value) == (str(second / "events.csv"), 2, "b", "5")
 
 
 def test_an_agent_that_met_nobody_is_fine(tmp_path):
@@ -583,7 +587,8 @@ def test_log_files_that_are_folders_and_odd_meta_keys_are_refused(tmp_path):
     meta_path = tmp_path / "log" / "meta.json"
     for meta, message, value in [({"units": {"time": "ms"}}, "key 'units.time' must be \"s\"", "ms"),
                                  ({"agent_ids": [1, 2, 3, 2]}, "lists an agent twice", 2),
-                                 ({"format": None}, "key 'format' is not", "null")]:
+                                 ({"format": None}, "key 'format' is not", "null"),
+                                 ({"units": "ms"}, "key 'units' must be an object", "ms")]:
         meta_path.write_text(json.dumps(meta))
         with pytest.raises(InputError, match=message) as caught:
             read_log(tmp_path / "log")
@@ -670,3 +675,53 @@ def test_an_id_column_of_lists_is_refused_naming_its_type(tmp_path):
     err = read_error(tmp_path)
     assert (err.file, err.column) == (str(tmp_path / "events.parquet"), "a")
     assert err.reason.startswith("agent IDs must be integers or text, not list<")
+
+
+# -- padded text IDs, float IDs beyond int64, blank lines ------------------------------------
+@pytest.mark.parametrize("ids", [["B7", "B7 ", "B8"], ["B12  ", " B13", "B1   "]])
+def test_padded_text_ids_read_back_exactly_from_a_csv_log(tmp_path, ids):
+    # write_log declares text IDs in meta.json; the CSV reader keeps a declared ID as written
+    log = EncounterLog.from_records([0.0, 1.0, 2.0], [ids[0], ids[1], ids[0]], [ids[1], ids[2], ids[2]],
+                                    status=([0.0], [ids[1]], ["S"]))
+    write_log(log, tmp_path, fmt="csv")
+    back = read_log(tmp_path)
+    assert back.agent_ids.tolist() == sorted(ids)
+    assert back.ids_of(back.a).tolist() == log.ids_of(log.a).tolist()
+    assert back.ids_of(back.b).tolist() == log.ids_of(log.b).tolist()
+    assert back.ids_of(back.status_agent).tolist() == [ids[1]]
+
+
+def test_csv_ids_that_trimming_would_merge_are_refused(tmp_path):
+    err = read_error(folder(tmp_path, "t,a,b\n0,B7,B8\n1,B8,B9\n2,B7 ,B9\n"))
+    assert (err.file, err.row, err.column, err.value) == (str(tmp_path / "events.csv"), 3, "a", "B7 ")
+    assert "only in the blanks around it" in str(err) and "\n" not in str(err)
+    # blanks round undeclared CSV IDs are still dropped when nothing collides
+    log = read_log(folder(tmp_path, "t, a, b\n0, B7, B8\n1, B8, B9 \n"))
+    assert log.agent_ids.tolist() == ["B7", "B8", "B9"]
+    # an undeclared padded spelling of a declared ID beside the declared one is refused too
+    err = read_error(folder(tmp_path, "t,a,b\n0,B7,B8\n1,B7 ,B9\n", meta='{"agent_ids": ["B7", "B8", "B9"]}'))
+    assert (err.row, err.column, err.value) == (2, "a", "B7 ")
+
+
+@pytest.mark.parametrize("value", [1e20, -2e19, 2.0 ** 63])
+def test_float_ids_beyond_int64_are_refused_without_a_warning(tmp_path, value):
+    pq.write_table(pa.table({"t": [0.0, 1.0], "a": [1.0, value], "b": [2.0, 2 * value]}), tmp_path / "events.parquet")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        err = read_error(tmp_path)
+    assert (err.file, err.row, err.column, err.value) == (str(tmp_path / "events.parquet"), 2, "a", value)
+    assert "int64 range" in str(err)
+
+
+def test_largest_float_id_within_int64_is_read_exactly(tmp_path):
+    big = 2.0 ** 63 - 1024  # the largest float64 below 2^63
+    pq.write_table(pa.table({"t": [0.0], "a": [-(2.0 ** 63)], "b": [big]}), tmp_path / "events.parquet")
+    assert read_log(tmp_path).agent_ids.tolist() == [-(2 ** 63), int(big)]
+
+
+def test_status_rows_count_blank_lines(tmp_path):
+    err = read_error(folder(tmp_path, "t,a,b\n0,1,2\n", status="t,agent,state\n\n0,1,RW\n\n0,1,S\n"))
+    assert (err.file, err.row) == (str(tmp_path / "status.csv"), 4)
+    assert "row 2 says agent 1 is RW" in str(err) and "row 4 says S" in str(err)
+    err = read_error(folder(tmp_path, "t,a,b\n0,1,2\n", status="t,agent,state\n\n0,1,RW\n\n1,2,walk\n"))
+    assert (err.row, err.column, err.value) == (4, "state", "walk")

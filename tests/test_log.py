@@ -151,6 +151,22 @@ def test_non_integer_float_id():
     assert (err.row, err.column, err.value) == (2, "a", 2.5)
 
 
+def test_float_ids_beyond_int64_are_refused_not_wrapped():
+    # 1e20 and 2e20 would both cast to -2^63: one agent
+    for ids in (np.array([1.0, 1e20]), pa.array([1.0, 1e20])):
+        err = error_of([0.0, 1.0], ids, np.array([2.0, 2e20]))
+        assert (err.row, err.column, err.value) == (2, "a", 1e20) and "int64 range" in err.reason
+    log = EncounterLog.from_records([0.0], np.array([-(2.0 ** 63)]), np.array([2.0 ** 62]))
+    assert log.agent_ids.tolist() == [-(2 ** 63), 2 ** 62]
+
+
+def test_status_errors_name_the_source_rows():
+    err = error_of([0.0], [1], [2], status=([0.0, 0.0], [1, 1], ["RW", "S"]), status_rows=[3, 7])
+    assert err.row == 7 and "row 3 says agent 1 is RW" in err.reason and "row 7 says S" in err.reason
+    err = error_of([0.0], [1], [2], status=([0.0, -1.0], [1, 1], ["RW", "S"]), status_rows=[3, 7])
+    assert (err.row, err.column) == (7, "t")
+
+
 def test_undeclared_ids():
     err = error_of([0.0, 1.0, 2.0], [0, 1, 2], [1, 7, 1], meta={"agent_count": 3})
     assert (err.file, err.row, err.column, err.value) == ("ev.csv", 2, "b", 7)

@@ -57,7 +57,8 @@ import pyarrow.csv as pcsv
 import pyarrow.parquet as pq
 
 from .errors import InputError, SwarmtopoError
-from .io import GZIP_MAGIC, SNIFF_BYTES, coarse_time, integer_ids, non_utf8_problem, refuse_binary
+from .io import (GZIP_MAGIC, SNIFF_BYTES, coarse_time, integer_ids, non_utf8_problem, refuse_binary,
+                 refuse_merged_by_trimming)
 from .log import MAX_TIME, TOO_LATE, EncounterLog
 
 FORMATS: tuple[str, ...] = ("csv", "parquet", "sociopatterns", "one")
@@ -130,14 +131,19 @@ def read_table_trace(path, *, fmt: str = "csv", skip_bad: bool = False, time_col
         raise SwarmtopoError(f"the time and the two ID columns must be three different columns, not "
                              f"{time_column!r}, {a_column!r}, {b_column!r}")
     rows = _Rows(str(path), skip_bad)
-    for line, cols in (_csv_batches(path, names, rows) if fmt == "csv" else _parquet_batches(path, names, rows)):
+    for line, written in (_csv_batches(path, names, rows) if fmt == "csv" else _parquet_batches(path, names, rows)):
+        cols = {k: _trim(v) for k, v in written.items()} if fmt == "csv" else written
         blank = _blank_row(cols) if fmt == "csv" else np.zeros(len(line), bool)  # Parquet has no blank lines
         rows.counts["blank_lines"] += int(blank.sum())
-        line, cols = line[~blank], {k: v.filter(pa.array(~blank)) for k, v in cols.items()}
+        line, cols, written = line[~blank], *({k: v.filter(pa.array(~blank)) for k, v in c.items()}
+                                              for c in (cols, written))
         t, ok = _times(cols["t"], line, names["t"], rows, minimum=0.0)
         ok &= _ids_ok(cols["a"], cols["b"], line, (names["a"], names["b"]), rows)
-        rows.keep(ok, line, t=t[ok], a=cols["a"].filter(pa.array(ok)), b=cols["b"].filter(pa.array(ok)))
+        # IDs are kept as written: trimming is checked not to merge two of them
+        rows.keep(ok, line, t=t[ok], a=written["a"].filter(pa.array(ok)), b=written["b"].filter(pa.array(ok)))
     t, a, b, line = rows.columns()
+    if fmt == "csv":
+        a, b = _trimmed_ids(a, b, line, names, rows.file)
     columns = {"time": names["t"], "a": names["a"], "b": names["b"]}
     if rows.time_type is not None:
         columns["time_type"] = rows.time_type
@@ -389,7 +395,7 @@ def _existing(path) -> Path:
 
 
 def _csv_batches(path: Path, names: dict[str, str], rows: _Rows):
-    """(data row numbers, {t, a, b: text columns}) per block of a CSV file.
+    """(data row numbers, {t, a, b: text columns, untrimmed}) per block of a CSV file.
 
     Single-threaded parsing, so rows that do not split into the header's columns reach
     the handler in order with their line numbers; blank lines arrive as empty rows.
@@ -419,7 +425,7 @@ def _csv_batches(path: Path, names: dict[str, str], rows: _Rows):
             line = k + np.searchsorted(skipped, k, side="right")
             delivered += batch.num_rows
             rows.lines += batch.num_rows
-            yield line, {key: _trim(batch.column(col)) for key, col in names.items()}
+            yield line, {key: batch.column(col) for key, col in names.items()}
         rows.lines += len(bad_rows)
     except pa.ArrowInvalid as exc:
         raise InputError(f"cannot parse CSV ({exc})", file=str(path)) from None
@@ -609,6 +615,17 @@ def _trim(col) -> pa.Array:
     if isinstance(col, pa.ChunkedArray):
         col = col.combine_chunks()
     return pc.utf8_trim_whitespace(col.fill_null(""))
+
+
+def _trimmed_ids(a: pa.Array, b: pa.Array, line, names: dict[str, str], file: str) -> tuple[pa.Array, pa.Array]:
+    """CSV ID columns trimmed of surrounding blanks; text IDs that differ only in those
+    blanks (``B7`` and ``B7 ``) are refused rather than merged (integers are numbers:
+    `` 7`` is 7)."""
+    trimmed = _trim(a), _trim(b)
+    if integer_ids(list(trimmed)) is None:
+        refuse_merged_by_trimming([(a, Path(file), names["a"], line), (b, Path(file), names["b"], line)],
+                                  pa.array([], pa.string()))
+    return trimmed
 
 
 def _blank_row(cols: dict[str, pa.Array]) -> np.ndarray:

@@ -29,9 +29,12 @@ another ``format``.  Agent IDs are integers or text: in a CSV file an ID column 
 integer only if every ID in the folder is written as an integer (``7``, or ``7.0`` as a
 float column is often written: the same agent; not ``007`` or ``-0``) and ``meta.json``
 does not declare text ``agent_ids``; otherwise all IDs are text, so ``"007"`` stays
-``"007"``.  Extra columns are ignored by :func:`read_log` (a name they repeat, such as
-the empty names of trailing empty columns, too) and kept by :func:`read_truth` /
-:func:`read_trajectories`.
+``"007"``.  Blanks round a CSV ID are dropped unless ``meta.json``'s ``agent_ids``
+lists the ID with them (so padded text IDs that :func:`write_log` wrote read back
+exactly); two text IDs that differ only in such blanks are refused, not merged.  CSV
+blank lines count as data rows and are skipped.  Extra columns are ignored by
+:func:`read_log` (a name they repeat, such as the empty names of trailing empty
+columns, too) and kept by :func:`read_truth` / :func:`read_trajectories`.
 
 CSV and Parquet go through pyarrow (multi-threaded C++ readers) and ID columns are
 dictionary-encoded, never turned into Python objects row by row: 10^6 events read in
@@ -72,6 +75,7 @@ GROUND_TRUTH_FILES = ("arena.geojson", *(f"{stem}.{fmt}" for stem in ("truth", "
 """Files that only a simulator can write; ``swarmtopo map`` never reads them."""
 
 _TABLE_STEMS = ("events", "status", "truth", "trajectories")
+_ID_COLUMNS = ("a", "b", "agent")
 _OTHER_ENCODINGS = ((b"\xff\xfe\x00\x00", "UTF-32"), (b"\x00\x00\xfe\xff", "UTF-32"),
                     (b"\xff\xfe", "UTF-16"), (b"\xfe\xff", "UTF-16"))
 _INTEGER_TEXT = r"^(0|-?[1-9][0-9]*)(\.0+)?$"
@@ -186,7 +190,8 @@ def read_log(directory) -> EncounterLog:
     InputError
         Naming the file, the 1-based data row, the column and the value: missing
         file or column, unparsable CSV, non-numeric / NaN / negative / missing times,
-        missing IDs, a == b, unknown states, IDs outside ``agent_ids`` /
+        missing IDs, float IDs that are not whole numbers within int64, CSV text IDs
+        that differ only in surrounding blanks, a == b, unknown states, IDs outside ``agent_ids`` /
         ``agent_count``, duplicate events, two status rows for one agent at one time,
         text that is not UTF-8, malformed ``meta.json`` or another ``format``; or when
         both ``events.csv`` and ``events.parquet`` exist.
@@ -196,31 +201,47 @@ def read_log(directory) -> EncounterLog:
     meta = _read_meta(meta_path)
     events_path = _find_table(directory, "events", required=True)
     status_path = _find_table(directory, "status")
-    events = _read_table(events_path, EVENT_COLUMNS)
-    status = _read_table(status_path, STATUS_COLUMNS) if status_path else None
+    events, event_rows = _read_table(events_path, EVENT_COLUMNS)
+    status, status_rows = _read_table(status_path, STATUS_COLUMNS) if status_path else (None, None)
 
-    id_cols = [(events[c], events_path, c) for c in ("a", "b")]
+    id_cols = [(events[c], events_path, c, event_rows) for c in ("a", "b")]
     if status is not None:
-        id_cols.append((status["agent"], status_path, "agent"))
-    ids = _id_arrays(id_cols, declared_text=_declares_text_ids(meta))
-    t = _number_column(events["t"], events_path, "t", "time")
+        id_cols.append((status["agent"], status_path, "agent", status_rows))
+    ids = _id_arrays(id_cols, declared=meta.get("agent_ids"))
+    t = _number_column(events["t"], events_path, "t", "time", event_rows)
     status_cols = None
     if status is not None:
-        status_cols = (_number_column(status["t"], status_path, "t", "time"), ids[2], status["state"])
+        status_cols = (_number_column(status["t"], status_path, "t", "time", status_rows), ids[2], status["state"])
     static = meta.pop("static", None)
     static_cols = None
     if static is not None:
         static_cols = ([entry["agent"] for entry in static], [entry["time"] for entry in static])
-    log = EncounterLog.from_records(
-        t, ids[0], ids[1], status=status_cols, static=static_cols, meta=meta,
-        source={"events": str(events_path), "status": str(status_path), "static": f"{meta_path} static"},
-    )
+    try:
+        log = EncounterLog.from_records(
+            t, ids[0], ids[1], status=status_cols, static=static_cols, meta=meta,
+            source={"events": str(events_path), "status": str(status_path), "static": f"{meta_path} static"},
+            event_rows=event_rows, status_rows=status_rows,
+        )
+    except InputError as exc:
+        tables = {str(events_path): (events, event_rows), str(status_path): (status, status_rows)}
+        raise _as_written(exc, tables) from None
     if meta.get("agent_ids") is None and meta.get("agent_count") is None:
         _refuse_unmatched_status(log, status_path, events_path)
     if "duration" in meta and meta["duration"] < log.last_time:
         raise InputError(f"key 'duration' is {meta['duration']:g} s but the log runs to t = {log.last_time:g} s",
                          file=str(meta_path), column="duration", value=meta["duration"])
     return log
+
+
+def _as_written(exc: InputError, tables: dict) -> InputError:
+    """``exc`` quoting its value as the file spells it (the log checks parsed numbers and
+    IDs: ``-1`` would be quoted as ``-1.0``, ``7.0`` as ``7``).  ``tables``: file name ->
+    (columns, source row of each value) of the files read."""
+    columns, rows = tables.get(exc.file, (None, None))
+    if columns is None or exc.row is None or exc.value is None or exc.column not in columns:
+        return exc
+    value = columns[exc.column][int(np.searchsorted(rows, exc.row))].as_py()
+    return InputError(exc.reason, file=exc.file, row=exc.row, column=exc.column, value=value)
 
 
 def _refuse_unmatched_status(log: EncounterLog, status_path, events_path) -> None:
@@ -274,13 +295,13 @@ def _read_ground_truth(directory, name: str, columns, id_columns, position_colum
     path = _find_table(directory, name)
     if path is None:
         return None
-    table = _read_table(path, columns, keep_all=True)
-    declared_text = _declares_text_ids(_read_meta(directory / "meta.json"))
-    ids = _id_arrays([(table[col], path, col) for col in id_columns], declared_text=declared_text)
-    out = {"t": _number_column(table["t"], path, "t", "time")}
+    table, rows = _read_table(path, columns, keep_all=True)
+    declared = _read_meta(directory / "meta.json").get("agent_ids")
+    ids = _id_arrays([(table[col], path, col, rows) for col in id_columns], declared=declared)
+    out = {"t": _number_column(table["t"], path, "t", "time", rows)}
     out.update({col: _id_numpy(values) for col, values in zip(id_columns, ids)})
     for col in position_columns:
-        out[col] = _number_column(table[col], path, col, "position")
+        out[col] = _number_column(table[col], path, col, "position", rows)
     return path, table, out
 
 
@@ -518,12 +539,16 @@ def _find_table(directory: Path, stem: str, *, required: bool = False) -> Path |
     return found[0]
 
 
-def _read_table(path: Path, required: tuple[str, ...], *, keep_all: bool = False) -> dict[str, pa.Array]:
-    """Columns of a CSV / Parquet file by (stripped) name.
+def _read_table(path: Path, required: tuple[str, ...], *,
+                keep_all: bool = False) -> tuple[dict[str, pa.Array], np.ndarray]:
+    """Columns of a CSV / Parquet file by (stripped) name, and the 1-based data row of
+    each of their values.
 
     CSV: the ``required`` columns are read as text (so IDs keep leading zeros and a bad
-    time can be located), trimmed of surrounding blanks; other columns are inferred.
-    Only ``required`` columns (plus ``state``) are read unless ``keep_all``.
+    time can be located), times and states trimmed of surrounding blanks (ID columns
+    are trimmed by :func:`_id_arrays`); other columns are inferred.  Blank lines count
+    as rows (as ``swarmtopo ingest`` counts them) and are dropped.  Only ``required``
+    columns (plus ``state``) are read unless ``keep_all``.
     """
     if path.suffix == ".csv":
         names = _csv_header(path)
@@ -555,10 +580,17 @@ def _read_table(path: Path, required: tuple[str, ...], *, keep_all: bool = False
         col = table.column(by_name[name]).combine_chunks()
         if pa.types.is_dictionary(col.type):
             col = col.dictionary_decode()
-        if path.suffix == ".csv" and name in text:
+        if path.suffix == ".csv" and name in text and name not in _ID_COLUMNS:
             col = pc.utf8_trim_whitespace(col)
         out[name] = col
-    return out
+    rows = np.arange(1, table.num_rows + 1)
+    if path.suffix == ".csv":
+        blank = np.logical_and.reduce([pc.equal(pc.utf8_length(pc.utf8_trim_whitespace(out[c])), 0)
+                                       .to_numpy(zero_copy_only=False) for c in text])
+        if blank.any():
+            keep = pa.array(~blank)
+            out, rows = {name: col.filter(keep) for name, col in out.items()}, rows[~blank]
+    return out, rows
 
 
 def _csv_header(path: Path) -> list[str]:
@@ -614,8 +646,9 @@ def non_utf8_problem(blocks) -> str | None:
 def _read_csv(path: Path, columns: list[str], text: set[str]) -> pa.Table:
     convert = pcsv.ConvertOptions(include_columns=columns, column_types={c: pa.string() for c in text},
                                   strings_can_be_null=False)
-    try:
-        return pcsv.read_csv(path, convert_options=convert)
+    try:  # blank lines are read, so that rows are numbered as the file's data lines
+        return pcsv.read_csv(path, parse_options=pcsv.ParseOptions(ignore_empty_lines=False),
+                             convert_options=convert)
     except pa.ArrowInvalid as exc:
         if "invalid UTF8" in str(exc):
             raise _not_utf8(path, columns, text) from None
@@ -627,7 +660,8 @@ def _read_csv(path: Path, columns: list[str], text: set[str]) -> pa.Table:
 def _not_utf8(path: Path, columns: list[str], text: set[str]) -> InputError:
     """The error for a text column that is not UTF-8, at its first bad row."""
     try:
-        raw = pcsv.read_csv(path, convert_options=pcsv.ConvertOptions(
+        raw = pcsv.read_csv(path, parse_options=pcsv.ParseOptions(ignore_empty_lines=False),
+                            convert_options=pcsv.ConvertOptions(
             include_columns=columns, column_types={c: pa.binary() for c in text}))
     except pa.ArrowInvalid as exc:  # a row that does not parse either
         return _csv_problem(path, exc)
@@ -677,8 +711,9 @@ def _csv_problem(path: Path, exc: Exception) -> InputError:
     return InputError(f"cannot parse CSV ({reason})", file=str(path))
 
 
-def _number_column(col: pa.Array, path: Path, name: str, what: str) -> np.ndarray:
-    """float64 column; text is parsed, and the first bad value is located exactly."""
+def _number_column(col: pa.Array, path: Path, name: str, what: str, rows: np.ndarray) -> np.ndarray:
+    """float64 column; text is parsed, and the first bad value is located exactly (at its
+    source row: ``rows[i]`` is the 1-based data row of value ``i``)."""
     kind = col.type
     if pa.types.is_string(kind) or pa.types.is_large_string(kind):
         try:
@@ -687,21 +722,22 @@ def _number_column(col: pa.Array, path: Path, name: str, what: str) -> np.ndarra
             i = _first_uncastable(col, pa.float64())
             value = col[i].as_py()
             problem = f"{what} is missing" if value == "" else f"{what} is not a number"
-            raise InputError(problem, file=str(path), row=i + 1, column=name, value=value) from None
+            raise InputError(problem, file=str(path), row=int(rows[i]), column=name, value=value) from None
     elif pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_decimal(kind):
         coarse = coarse_time(col) if what == "time" else None
         if coarse is not None:
             i, problem = coarse
-            raise InputError(problem, file=str(path), row=i + 1, column=name, value=col[i].as_py())
+            raise InputError(problem, file=str(path), row=int(rows[i]), column=name, value=col[i].as_py())
         col = pc.cast(col, pa.float64(), safe=False)  # integers beyond 2^53 round; times that large are refused
     elif pa.types.is_null(kind) and len(col) == 0:
         col = pa.array([], pa.float64())
     else:
-        raise InputError(f"{what} must be a number, not {kind}", file=str(path), row=1, column=name,
+        raise InputError(f"{what} must be a number, not {kind}", file=str(path),
+                         row=int(rows[0]) if len(rows) else None, column=name,
                          value=col[0].as_py() if len(col) else None)
     if col.null_count:
         i = int(np.argmax(col.is_null().to_numpy(zero_copy_only=False)))
-        raise InputError(f"{what} is missing", file=str(path), row=i + 1, column=name)
+        raise InputError(f"{what} is missing", file=str(path), row=int(rows[i]), column=name)
     return col.to_numpy(zero_copy_only=False)
 
 
@@ -737,19 +773,26 @@ def _first_uncastable(col: pa.Array, to_type) -> int:
     return lo
 
 
-def _id_arrays(columns: list[tuple[pa.Array, Path, str]], *, declared_text: bool) -> list:
-    """Give all ID columns of a folder one kind: int64 numpy arrays, or pyarrow text.
+def _id_arrays(columns: list[tuple[pa.Array, Path, str, np.ndarray]], *, declared) -> list:
+    """Give all ID columns ``(column, file, name, source rows)`` of a folder one kind:
+    int64 numpy arrays, or pyarrow text.
 
     Integer if every column is integer-typed (floats are left to the log's integrality
     check) or, in CSV, holds only IDs written as integers (:func:`integer_ids`), and meta
-    declares no text IDs.  Text columns of a Parquet file are text whatever they hold;
-    a column that cannot be read as text (a list, a struct) is refused.
+    declares no text IDs (``declared``: its ``agent_ids``).  Text columns of a Parquet
+    file are text whatever they hold; a column that cannot be read as text (a list, a
+    struct) is refused.  A CSV ID is trimmed of surrounding blanks unless ``declared``
+    lists it as written (so that a log's padded text IDs read back exactly); two text IDs
+    that trimming would merge are refused.
     """
+    declared = list(declared or [])
+    kept = pa.array([str(v) for v in declared], pa.string())
     checked = []  # (column, is numeric, from a CSV file)
-    for col, path, name in columns:
+    written = []  # (CSV column as written, file, name, source rows)
+    for col, path, name, rows in columns:
         if col.null_count:
             i = int(np.argmax(col.is_null().to_numpy(zero_copy_only=False)))
-            raise InputError("agent ID is missing", file=str(path), row=i + 1, column=name)
+            raise InputError("agent ID is missing", file=str(path), row=int(rows[i]), column=name)
         numeric = pa.types.is_integer(col.type) or pa.types.is_floating(col.type)
         if not numeric:
             try:
@@ -757,7 +800,12 @@ def _id_arrays(columns: list[tuple[pa.Array, Path, str]], *, declared_text: bool
             except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
                 raise InputError(f"agent IDs must be integers or text, not {col.type}", file=str(path),
                                  column=name) from None
-        checked.append((col, numeric, path.suffix == ".csv"))
+        csv = path.suffix == ".csv"
+        if csv:
+            written.append((col, path, name, rows))
+            col = _trimmed_ids(col, kept)
+        checked.append((col, numeric, csv))
+    declared_text = any(isinstance(v, str) for v in declared)
     if not declared_text and all(numeric or csv for _, numeric, csv in checked):  # CSV has no types
         texts = integer_ids([col for col, numeric, _ in checked if not numeric])
         if texts is not None:
@@ -769,7 +817,37 @@ def _id_arrays(columns: list[tuple[pa.Array, Path, str]], *, declared_text: bool
                 pass
             else:
                 return [col.to_numpy(zero_copy_only=False) for col in ints]
+    refuse_merged_by_trimming(written, kept)
     return [pc.cast(col, pa.string()) if numeric else col for col, numeric, _ in checked]
+
+
+def _trimmed_ids(col: pa.Array, kept: pa.Array) -> pa.Array:
+    """CSV ID text trimmed of surrounding blanks, except the IDs in ``kept`` (as written)."""
+    return pc.if_else(pc.is_in(col, value_set=kept), col, pc.utf8_trim_whitespace(col))
+
+
+def refuse_merged_by_trimming(written: list[tuple[pa.Array, Path, str, np.ndarray]], kept: pa.Array) -> None:
+    """InputError at the first padded spelling of an ID that another spelling in the CSV
+    ID columns ``written`` also trims to: trimming would merge two distinct text IDs."""
+    if not written:
+        return
+    spellings = pc.unique(pa.concat_arrays([col for col, *_ in written]))
+    ids = _trimmed_ids(spellings, kept)
+    enc = pc.dictionary_encode(ids)
+    if len(enc.dictionary) == len(spellings):
+        return
+    index = enc.indices.to_numpy(zero_copy_only=False)
+    merged = np.bincount(index, minlength=len(enc.dictionary))[index] > 1
+    padded = spellings.filter(pa.array(merged & ~pc.equal(spellings, ids).to_numpy(zero_copy_only=False)))
+    for col, path, name, rows in written:
+        hit = pc.is_in(col, value_set=padded).to_numpy(zero_copy_only=False)
+        if hit.any():
+            i = int(np.argmax(hit))
+            trimmed = col[i].as_py().strip()
+            raise InputError(f"agent ID differs from the ID {trimmed!r} only in the blanks around it, which a CSV "
+                             f"field drops: the two would merge into one agent (spell each agent one way, or use "
+                             f"Parquet, which keeps blanks)", file=str(path), row=int(rows[i]), column=name,
+                             value=col[i].as_py())
 
 
 def integer_ids(columns: list[pa.Array]) -> list[pa.Array] | None:
@@ -822,6 +900,9 @@ def _read_meta(path: Path) -> dict:
                 raise InputError(f"key 'static': entry {i + 1} must be an object with 'agent' and 'time'",
                                  file=str(path), value=entry)
     units = meta.get("units")
+    if units is not None and not isinstance(units, dict):
+        raise InputError("key 'units' must be an object such as {\"time\": \"s\", \"length\": \"mm\"}",
+                         file=str(path), column="units", value=units)
     if isinstance(units, dict) and units.get("time", "s") != "s":
         raise InputError("key 'units.time' must be \"s\": swarmtopo reads times in seconds", file=str(path),
                          column="units.time", value=units["time"])
@@ -856,6 +937,3 @@ def _read_meta(path: Path) -> dict:
                              file=str(path), value=count)
     return meta
 
-
-def _declares_text_ids(meta: dict) -> bool:
-    return any(isinstance(v, str) for v in meta.get("agent_ids") or [])

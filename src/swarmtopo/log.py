@@ -16,6 +16,7 @@ the IDs.  Events are stored canonically: ``a < b`` (codes), sorted by (t, a, b).
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -81,6 +82,7 @@ class EncounterLog:
         meta: dict | None = None,
         source: dict[str, str] | None = None,
         event_rows=None,
+        status_rows=None,
     ) -> "EncounterLog":
         """Validate raw columns and build a canonical log.
 
@@ -102,6 +104,8 @@ class EncounterLog:
         event_rows
             The source row of each event (1-based), quoted in error messages instead
             of its position (a reader that dropped blank or skipped lines knows them).
+        status_rows
+            The same for the status rows.
 
         Raises
         ------
@@ -116,22 +120,18 @@ class EncounterLog:
         src_e = source["events"]
 
         def row(i) -> int:
-            return int(event_rows[i]) if event_rows is not None else int(i) + 1
+            return _source_row(event_rows, i)
 
-        try:
+        with _rows_of(event_rows):
             t = _times(t, src_e, "t")
             ev_a, ev_b = _factorize_ids(a, src_e, "a"), _factorize_ids(b, src_e, "b")
-        except InputError as exc:
-            if event_rows is None or exc.row is None:
-                raise
-            raise InputError(exc.reason, file=exc.file, row=row(exc.row - 1), column=exc.column,
-                             value=exc.value) from None
         if not (len(t) == len(ev_a.index) == len(ev_b.index)):
             raise InputError("columns t, a, b have different lengths", file=src_e)
         if status is not None:
-            st_t = _times(status[0], source["status"], "t")
-            st_agent = _factorize_ids(status[1], source["status"], "agent")
-            st_state = parse_states(status[2], source["status"])
+            with _rows_of(status_rows):
+                st_t = _times(status[0], source["status"], "t")
+                st_agent = _factorize_ids(status[1], source["status"], "agent")
+                st_state = parse_states(status[2], source["status"])
         else:
             st_t, st_agent, st_state = np.empty(0), _IdColumn.empty("", ""), np.empty(0, np.int8)
         if static is not None:
@@ -154,7 +154,9 @@ class EncounterLog:
                 if bad.any():
                     i = int(np.argmax(bad))
                     raise InputError("agent ID is not among the agents the metadata declares",
-                                     file=col.src, row=row(i) if col.src == src_e else i + 1,
+                                     file=col.src, row=_source_row(event_rows if col.src == src_e else
+                                                                   status_rows if col.src == source["status"]
+                                                                   else None, i),
                                      column=col.column, value=col.value(i))
             agent_ids = np.unique(declared)
         else:
@@ -186,7 +188,7 @@ class EncounterLog:
                              value=f"{exact_time(t[k])}, {agent_ids[lo[k]]}, {agent_ids[hi[k]]}")
 
         st_order = np.lexsort((st_t, cst))
-        _refuse_repeated_status(st_t, cst, st_state, st_order, agent_ids, source["status"])
+        _refuse_repeated_status(st_t, cst, st_state, st_order, agent_ids, source["status"], status_rows)
         if len(csa) != len(np.unique(csa)):
             _, first = np.unique(csa, return_index=True)
             i = int(np.setdiff1d(np.arange(len(csa)), first)[0])
@@ -253,6 +255,23 @@ class EncounterLog:
     def __repr__(self) -> str:
         return (f"EncounterLog(events={self.n_events}, agents={self.n_agents}, "
                 f"status={len(self.status_t)}, static={len(self.static_agent)}, duration={self.duration:g} s)")
+
+
+def _source_row(rows, i) -> int:
+    """The 1-based source row of position ``i``: ``rows[i]``, or ``i + 1`` without ``rows``."""
+    return int(rows[i]) if rows is not None else int(i) + 1
+
+
+@contextmanager
+def _rows_of(rows):
+    """Re-raise an InputError with its row (a 1-based position) as the source row ``rows`` gives."""
+    try:
+        yield
+    except InputError as exc:
+        if rows is None or exc.row is None:
+            raise
+        raise InputError(exc.reason, file=exc.file, row=_source_row(rows, exc.row - 1), column=exc.column,
+                         value=exc.value) from None
 
 
 # -- column validation ---------------------------------------------------------------
@@ -336,6 +355,11 @@ def _factorize_ids(values, src, col) -> _IdColumn:
             i = int(np.argmax(bad))
             raise InputError("agent ID must be an integer or a text label", file=src, row=i + 1,
                              column=col, value=arr[i])
+        huge = (arr >= 2.0 ** 63) | (arr < -(2.0 ** 63))
+        if huge.any():  # the cast would wrap them, merging distinct agents
+            i = int(np.argmax(huge))
+            raise InputError("a float agent ID must be a whole number within the int64 range (|ID| < 2^63): "
+                             "write such IDs as integers or text", file=src, row=i + 1, column=col, value=arr[i])
         arr = arr.astype(np.int64)
     elif arr.dtype.kind in "iub":
         arr = arr.astype(np.int64)
@@ -436,24 +460,26 @@ def state_labels(codes) -> np.ndarray:
     return _STATE_LABELS[codes]
 
 
-def _refuse_repeated_status(t, agent, state, order, agent_ids, src) -> None:
+def _refuse_repeated_status(t, agent, state, order, agent_ids, src, rows) -> None:
     """Two status rows for one agent at one time are either a contradiction or a
-    duplicate; either way the log would depend on row order, so refuse them."""
+    duplicate; either way the log would depend on row order, so refuse them.  ``rows``:
+    the source row of each status row (None: its position)."""
     t, agent = t[order], agent[order]
     repeated = (np.diff(t) == 0) & (np.diff(agent) == 0)
     if not repeated.any():
         return
     k = int(np.argmax(repeated))
-    first, second = int(order[k]), int(order[k + 1])  # lexsort is stable: first < second
+    i, j = int(order[k]), int(order[k + 1])  # lexsort is stable: i < j
+    first, second = _source_row(rows, i), _source_row(rows, j)
     who = agent_ids[agent[k]]
     who = int(who) if isinstance(who, np.integer) else who
     when = float(t[k])
-    s1, s2 = STATES[state[first]], STATES[state[second]]
+    s1, s2 = STATES[state[i]], STATES[state[j]]
     if s1 == s2:
-        raise InputError(f"duplicate status row: row {second + 1} repeats row {first + 1} "
-                         f"(t={when!r}, agent {who!r}, {s1})", file=src, row=second + 1)
-    raise InputError(f"conflicting status rows: row {first + 1} says agent {who!r} is {s1} at t={when!r}, "
-                     f"row {second + 1} says {s2}", file=src, row=second + 1, column="state", value=s2)
+        raise InputError(f"duplicate status row: row {second} repeats row {first} "
+                         f"(t={when!r}, agent {who!r}, {s1})", file=src, row=second)
+    raise InputError(f"conflicting status rows: row {first} says agent {who!r} is {s1} at t={when!r}, "
+                     f"row {second} says {s2}", file=src, row=second, column="state", value=s2)
 
 
 def _declared_ids(meta) -> np.ndarray | None:
