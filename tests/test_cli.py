@@ -356,9 +356,6 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     assert doc["params"]["wall_follow_weight"] == MapConfig.wall_follow_weight
     assert doc["params"]["window_scales"] == list(MapConfig.window_scales)
     assert doc["params"]["landmark_bands"] == list(fitted_landmark_bands(load_classifier("default")))  # unset: its own
-    scaled = run("map", simulated[0], "--out", tmp_path / "s", "-q", "--window-scales", "0.5,1")
-    assert scaled.returncode == 0, scaled.stderr
-    assert json.loads((tmp_path / "s" / "map.json").read_text())["params"]["window_scales"] == [0.5, 1.0]
     assert doc["params"]["max_windows"] == MapConfig.max_windows
     capped = run("map", simulated[0], "--out", tmp_path / "c", "-q", "--window-length", "4", "--max-windows", "3")
     assert capped.returncode == 0, capped.stderr
@@ -366,24 +363,25 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     spans = {(w["t0"], w["t1"]) for w in doc["regions"][0]["windows"]}
     assert doc["params"]["max_windows"] == 3 and len(spans) == 3  # one per length, each mapped once per band
     assert len(doc["regions"][0]["windows"]) == 3 * len(doc["params"]["landmark_bands"])
-    inspected = run("map", simulated[0], "--out", tmp_path / "i", "-q", "--window-length", "4", "--agreement", "always")
+    inspected = run("map", simulated[0], "--out", tmp_path / "i", "-q", "--window-length", "4", "--agreement", "always",
+                    "--window-scales", "0.5,1")
     assert inspected.returncode == 0, inspected.stderr
-    agreement = json.loads((tmp_path / "i" / "map.json").read_text())["regions"][0]["agreement"]
+    doc = json.loads((tmp_path / "i" / "map.json").read_text())
+    assert doc["params"]["window_scales"] == [0.5, 1.0]
+    agreement = doc["regions"][0]["agreement"]
     assert len(agreement) == 5 and all(0 <= a <= 1 for a in agreement)
-    every = run("map", simulated[0], "--out", tmp_path / "e", "-q", "--window-length", "4", "--max-windows", "none")
+    every = run("map", simulated[0], "--out", tmp_path / "e", "-q", "--window-length", "4", "--max-windows", "none",
+                "--landmark-bands", "1,0.5")
     assert every.returncode == 0, every.stderr
     doc = json.loads((tmp_path / "e" / "map.json").read_text())
     assert doc["params"]["max_windows"] is None and len(doc["regions"][0]["windows"]) > 3
+    assert doc["params"]["landmark_bands"] == [1.0, 0.5]
+    assert [w["band"] for w in doc["regions"][0]["windows"]][:2] == [1.0, 0.5]
     for bad in ("0", "-1", "2.5", "abc"):
         assert_one_line_error(run("map", simulated[0], "--max-windows", bad), "whole number >= 1", code=2)
     assert_one_line_error(run("map", simulated[0], "--max-windows", "2"), "at least the number of window scales", code=2)
     assert_one_line_error(run("map", simulated[0], "--paper", "--max-windows", "5"), "--paper fixes --max-windows",
                           code=2)
-    banded = run("map", simulated[0], "--out", tmp_path / "b", "-q", "--window-length", "4", "--landmark-bands", "1,0.5")
-    assert banded.returncode == 0, banded.stderr
-    doc = json.loads((tmp_path / "b" / "map.json").read_text())
-    assert doc["params"]["landmark_bands"] == [1.0, 0.5]
-    assert [w["band"] for w in doc["regions"][0]["windows"]][:2] == [1.0, 0.5]
     assert_one_line_error(run("map", simulated[0], "--landmark-bands", "1,1.5"), "distinct numbers in (0, 1]", code=2)
     assert_one_line_error(run("map", simulated[0], "--landmark-bands", "0.5,x"), "comma-separated", code=2)
     assert_one_line_error(run("map", simulated[0], "--landmark-bands", "0.5,0.5"), "must be distinct", code=2)
