@@ -20,14 +20,19 @@ log and seconds per map; then the reliability of the beta_1 confidence over all 
 regimes' maps (Brier score against a constant, and its bins).
 
     python benchmarks/outside_suite.py [--per-regime 12] [--first 0] [--regimes NAME ...] [--set FIELD=VALUE ...]
-                                       [--contact-trace]
+                                       [--contact-trace] [--band-scores]
 
 ``--first`` is the index of the first case of each regime (``--first 12`` the next
 twelve); ``--set`` maps with ``MapConfig`` fields changed (as
 ``benchmarks/levers.py``'s ``FIELD=VALUE`` variants: ``--set window_encounters=40``);
 ``--contact-trace`` maps each log's encounters only, as a real contact trace comes
 (``experiments.sweep.contact_trace``: no status, no r_d or speeds; ``map`` then reads it
-with the ``trace`` classifier; no plan figure is printed then: ``plan`` models log folders).
+with the ``trace`` classifier; no plan figure is printed then: ``plan`` models log folders);
+``--band-scores`` prints, per regime and landmark band, where the band's windows put the
+true count's ranks: the mean over cases of S_beta - ln tau_1 (the last true hole, beta the
+true beta_1; cases with a hole) and S_(beta+1) - ln tau_1 (the first noise rank), S_k
+pooled over that band's windows of the largest region, and how many cases' first noise
+rank passes (a hole too many if that band were read alone).
 """
 
 from __future__ import annotations
@@ -43,9 +48,10 @@ import numpy as np
 from swarmtopo.arena import HOLE_SHAPES, OUTER_SHAPES, random_arena
 from swarmtopo.errors import SwarmtopoError
 from swarmtopo.experiments.accuracy import ROOM_SIDE, Rate, reliability, reliability_bin_lines
-from swarmtopo.experiments.sweep import contact_trace, stripped_log
+from swarmtopo.experiments.sweep import cached_classifier, contact_trace, stripped_log
 from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.plan import load_plan
+from swarmtopo.ratio import RatioClassifier, pooled_scores
 from swarmtopo.sim import MotionParams, SensingParams, simulate
 
 from levers import config_override
@@ -121,13 +127,45 @@ def _run(task):
                    rng=seed % 2**32)
     log = contact_trace(stripped_log(sim.log)) if as_trace else stripped_log(sim.log)
     start = time.perf_counter()
+    margins = {}
     try:
         tmap = map_encounters(log, MapConfig(seed=seed % 2**32, embed_dim=0, cycles=False, **options))
         mapped, confidence = (tmap.betti[0], tmap.betti[1]), tmap.confidence[1]
+        margins = band_margins(tmap, arena.betti[1])
     except SwarmtopoError as error:  # a log the pipeline refuses is a wrong map, with its reason
         mapped, confidence = (str(error)[:80], None), None
     return {"regime": regime_name, "family": family, "area": area, "truth": tuple(arena.betti), "mapped": mapped,
-            "confidence": confidence, "events": log.n_events, "seconds": time.perf_counter() - start}
+            "confidence": confidence, "events": log.n_events, "seconds": time.perf_counter() - start,
+            "band_margins": margins}
+
+
+def band_margins(tmap, beta1: int) -> dict[float, tuple[float | None, float]]:
+    """Per landmark band: (S_beta - ln tau_1 or None without a hole, S_(beta+1) - ln tau_1),
+    S pooled over the band's windows of the largest region (``--band-scores``); empty
+    for a classifier that does not pool ratio scores."""
+    classifier = cached_classifier(tmap.classifier["classifier"])
+    if not isinstance(classifier, RatioClassifier):
+        return {}
+    thresholds = classifier.thresholds_[1]
+    region = max(tmap.regions, key=lambda r: r.n_events)
+    margins = {}
+    for band in sorted({w.band for w in region.windows}, reverse=True):
+        scores = pooled_scores([w.diagram for w in region.windows if w.band == band], 1, thresholds.q)
+        scores = np.concatenate([scores, np.zeros(beta1 + 1)]) - np.log(thresholds.tau)  # a missing rank scores 0
+        margins[band] = (float(scores[beta1 - 1]) if beta1 else None, float(scores[beta1]))
+    return margins
+
+
+def band_lines(rows) -> list[str]:
+    """``--band-scores``' lines of one regime (module docstring)."""
+    lines = []
+    for band in sorted({b for r in rows for b in r["band_margins"]}, reverse=True):
+        pairs = [r["band_margins"][band] for r in rows if band in r["band_margins"]]
+        holes = [h for h, _ in pairs if h is not None]
+        noise = [n for _, n in pairs]
+        lines.append(f"    band {band:g}: last hole S - ln tau {np.mean(holes) if holes else float('nan'):+.2f}, "
+                     f"first noise rank {np.mean(noise):+.2f}, passing in {sum(n > 0 for n in noise)} of {len(noise)}")
+    return lines
 
 
 def main() -> None:
@@ -138,6 +176,7 @@ def main() -> None:
     parser.add_argument("--set", nargs="*", default=[], metavar="FIELD=VALUE", help="MapConfig fields to change")
     parser.add_argument("--processes", type=int, default=2)
     parser.add_argument("--contact-trace", action="store_true", help="map the encounters only (a contact trace)")
+    parser.add_argument("--band-scores", action="store_true", help="per band, the pooled scores' margins (docstring)")
     args = parser.parse_args()
     options = {k: v for text in args.set for k, v in config_override(text).items()}
     names = [n for n in REGIMES if any(n.startswith(p) for p in args.regimes)]
@@ -164,6 +203,8 @@ def main() -> None:
               f"wrong {np.mean(conf_wrong) if conf_wrong else float('nan'):.2f}; "
               f"{int(np.median([r['events'] for r in rows]))} events, {np.mean([r['seconds'] for r in rows]):.1f} s per map"
               + (f"\n    wrong: {listed}" if listed else ""))
+        if args.band_scores:
+            print("\n".join(band_lines(rows)))
     print(f"all: {total}/{len(results)} exact")
     rel = reliability([{"confidence_betti1": r["confidence"], "betti1_right": r["mapped"][1] == r["truth"][1]}
                        for r in results], 1)

@@ -1,8 +1,10 @@
 """The command line as a user meets it: real processes, exit codes, stdout/stderr."""
 
 import json
+import os
 import subprocess
 import sys
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +20,13 @@ def run(*args, cwd=None):
                           text=True, cwd=cwd, timeout=300)
 
 
+def run_all(*commands):
+    """:func:`run` of each command (a tuple of arguments), as many at once as the machine
+    has cores: a short run is mostly the CLI's start-up."""
+    with ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
+        return list(pool.map(lambda args: run(*args), commands))
+
+
 def assert_one_line_error(proc, *fragments, code=1):
     assert proc.returncode == code, proc.stderr
     assert "Traceback" not in proc.stderr
@@ -25,6 +34,14 @@ def assert_one_line_error(proc, *fragments, code=1):
     assert len(lines) == 1, proc.stderr
     for fragment in fragments:
         assert fragment in lines[0], lines[0]
+
+
+def assert_one_line_errors(*cases):
+    """:func:`assert_one_line_error` of each (arguments, fragments, exit code), the runs
+    made by :func:`run_all`."""
+    for (args, fragments, code), proc in zip(cases, run_all(*(case[0] for case in cases)), strict=True):
+        assert proc.returncode == code, (args, proc.stderr)
+        assert_one_line_error(proc, *fragments, code=code)
 
 
 @pytest.fixture(scope="module")
@@ -177,26 +194,25 @@ def test_overlapping_holes_arena_is_one_line(tmp_path):
 
 
 def test_bad_option_values(simulated, tmp_path):
-    assert_one_line_error(run("map", simulated[0], "--out", tmp_path / "x", "--metric", "euclid"),
-                          "unknown metric 'euclid'", code=2)
-    assert_one_line_error(run("map", simulated[0], "--max-windows", 2), "at least the number of window scales", code=2)
-    assert_one_line_error(run("map", simulated[0], "--agreement", "never"), "agreement must be one of auto, always",
-                          code=2)
-    assert_one_line_error(run("map", simulated[0], "--landmarks", 2001), "'--landmarks'", code=2)
-    for window in ("inf:", ":-inf"):
-        assert_one_line_error(run("map", simulated[0], "--window", window), "would hold nothing", code=2)
-    assert_one_line_error(run("map", simulated[0], "--window", "1e9:2e9"),
-                          "no encounter events in the window [1000000000, 2000000000] s; the log's events run from")
-    assert_one_line_error(run("map", simulated[0], "--window", "abc"), "T0:T1", code=2)
-    assert_one_line_error(run("simulate", "--format", "xml", "--out", tmp_path / "y"), "xml", code=2)
-    for command in (["map", simulated[0]], ["simulate", "--out", tmp_path / "z"], ["demo", "--out", tmp_path / "w"]):
-        assert_one_line_error(run(*command, "--seed", -1), "--seed", code=2)
-    assert_one_line_error(run("simulate", "--out", tmp_path / "z", "--static-time", 3), "--static-fraction", code=2)
-    for option, value in (("--dt", 0), ("--rd", -1), ("--duration", "inf"), ("--trajectories", 0)):
-        assert_one_line_error(run("simulate", "--out", tmp_path / "z", option, value), f"'{option}'", code=2)
-    assert_one_line_error(run("plan", "--area", 0, "--agents", 200, "--duration", 30), "'--area'", code=2)
-    for option, value in (("--hop-cost", 1e10), ("--wall-follow-weight", 1e7)):
-        assert_one_line_error(run("map", simulated[0], option, value), f"'{option}'", code=2)
+    log = simulated[0]
+    assert_one_line_errors(
+        (("map", log, "--out", tmp_path / "x", "--metric", "euclid"), ("unknown metric 'euclid'",), 2),
+        (("map", log, "--max-windows", 2), ("at least the number of window scales",), 2),
+        (("map", log, "--agreement", "never"), ("agreement must be one of auto, always",), 2),
+        (("map", log, "--landmarks", 2001), ("'--landmarks'",), 2),
+        *((("map", log, "--window", window), ("would hold nothing",), 2) for window in ("inf:", ":-inf")),
+        (("map", log, "--window", "1e9:2e9"),
+         ("no encounter events in the window [1000000000, 2000000000] s; the log's events run from",), 1),
+        (("map", log, "--window", "abc"), ("T0:T1",), 2),
+        (("simulate", "--format", "xml", "--out", tmp_path / "y"), ("xml",), 2),
+        *(((*command, "--seed", -1), ("--seed",), 2)
+          for command in (("map", log), ("simulate", "--out", tmp_path / "z"), ("demo", "--out", tmp_path / "w"))),
+        (("simulate", "--out", tmp_path / "z", "--static-time", 3), ("--static-fraction",), 2),
+        *((("simulate", "--out", tmp_path / "z", option, value), (f"'{option}'",), 2)
+          for option, value in (("--dt", 0), ("--rd", -1), ("--duration", "inf"), ("--trajectories", 0))),
+        (("plan", "--area", 0, "--agents", 200, "--duration", 30), ("'--area'",), 2),
+        *((("map", log, option, value), (f"'{option}'",), 2)
+          for option, value in (("--hop-cost", 1e10), ("--wall-follow-weight", 1e7))))
     assert not (tmp_path / "z").exists()
 
 
@@ -333,7 +349,17 @@ def test_quiet_verbose_and_pipes(tmp_path, simulated):
 
 
 def test_map_paper_and_pipeline_options(simulated, tmp_path):
-    paper = run("map", simulated[0], "--out", tmp_path / "p", "--paper")
+    log = simulated[0]
+    paper, default, auto, capped, inspected, every = run_all(
+        ("map", log, "--out", tmp_path / "p", "--paper"),
+        ("map", log, "--out", tmp_path / "d", "--hop-cost", "1.5", "--window-length", "8", "--diffusion-time", "0.4",
+         "--wall-follow-weight", "1.5"),
+        ("map", log, "--out", tmp_path / "a", "-q", "--window-length", "auto"),
+        ("map", log, "--out", tmp_path / "c", "-q", "--window-length", "4", "--max-windows", "3"),
+        ("map", log, "--out", tmp_path / "i", "-q", "--window-length", "4", "--agreement", "always",
+         "--window-scales", "0.5,1"),
+        ("map", log, "--out", tmp_path / "e", "-q", "--window-length", "4", "--max-windows", "none",
+         "--landmark-bands", "1,0.5"))
     assert paper.returncode == 0, paper.stderr
     doc = json.loads((tmp_path / "p" / "map.json").read_text())
     assert doc["params"]["hop_cost"] == 0.0 and doc["params"]["window_length"] == "inf"
@@ -341,15 +367,12 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     assert doc["params"]["window_length_used"] is None and doc["params"]["wall_follow_weight"] is None
     assert doc["classifier"]["classifier"] == "paper" and len(doc["regions"][0]["windows"]) == 1
     assert doc["params"]["landmark_bands"] == [1.0]
-    default = run("map", simulated[0], "--out", tmp_path / "d", "--hop-cost", "1.5", "--window-length", "8",
-                  "--diffusion-time", "0.4", "--wall-follow-weight", "1.5")
     assert default.returncode == 0, default.stderr
     doc = json.loads((tmp_path / "d" / "map.json").read_text())
     assert doc["params"]["wall_follow_weight"] == 1.5
     assert doc["params"]["hop_cost_used"] == 1.5 and doc["params"]["window_length"] == 8.0
     assert doc["params"]["diffusion_time_used"] == 0.4 and doc["params"]["diffusion_time_source"] == "given"
     assert len(doc["regions"][0]["windows"]) > 1
-    auto = run("map", simulated[0], "--out", tmp_path / "a", "-q", "--window-length", "auto")
     assert auto.returncode == 0, auto.stderr
     doc = json.loads((tmp_path / "a" / "map.json").read_text())
     assert doc["params"]["window_length"] is None and "encounters" in doc["params"]["window_source"]
@@ -357,51 +380,40 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     assert doc["params"]["window_scales"] == list(MapConfig.window_scales)
     assert doc["params"]["landmark_bands"] == list(fitted_landmark_bands(load_classifier("default")))  # unset: its own
     assert doc["params"]["max_windows"] == MapConfig.max_windows
-    capped = run("map", simulated[0], "--out", tmp_path / "c", "-q", "--window-length", "4", "--max-windows", "3")
     assert capped.returncode == 0, capped.stderr
     doc = json.loads((tmp_path / "c" / "map.json").read_text())
     spans = {(w["t0"], w["t1"]) for w in doc["regions"][0]["windows"]}
     assert doc["params"]["max_windows"] == 3 and len(spans) == 3  # one per length, each mapped once per band
     assert len(doc["regions"][0]["windows"]) == 3 * len(doc["params"]["landmark_bands"])
-    inspected = run("map", simulated[0], "--out", tmp_path / "i", "-q", "--window-length", "4", "--agreement", "always",
-                    "--window-scales", "0.5,1")
     assert inspected.returncode == 0, inspected.stderr
     doc = json.loads((tmp_path / "i" / "map.json").read_text())
     assert doc["params"]["window_scales"] == [0.5, 1.0]
     agreement = doc["regions"][0]["agreement"]
     assert len(agreement) == 5 and all(0 <= a <= 1 for a in agreement)
-    every = run("map", simulated[0], "--out", tmp_path / "e", "-q", "--window-length", "4", "--max-windows", "none",
-                "--landmark-bands", "1,0.5")
     assert every.returncode == 0, every.stderr
     doc = json.loads((tmp_path / "e" / "map.json").read_text())
     assert doc["params"]["max_windows"] is None and len(doc["regions"][0]["windows"]) > 3
     assert doc["params"]["landmark_bands"] == [1.0, 0.5]
     assert [w["band"] for w in doc["regions"][0]["windows"]][:2] == [1.0, 0.5]
-    for bad in ("0", "-1", "2.5", "abc"):
-        assert_one_line_error(run("map", simulated[0], "--max-windows", bad), "whole number >= 1", code=2)
-    assert_one_line_error(run("map", simulated[0], "--max-windows", "2"), "at least the number of window scales", code=2)
-    assert_one_line_error(run("map", simulated[0], "--paper", "--max-windows", "5"), "--paper fixes --max-windows",
-                          code=2)
-    assert_one_line_error(run("map", simulated[0], "--landmark-bands", "1,1.5"), "distinct numbers in (0, 1]", code=2)
-    assert_one_line_error(run("map", simulated[0], "--landmark-bands", "0.5,x"), "comma-separated", code=2)
-    assert_one_line_error(run("map", simulated[0], "--landmark-bands", "0.5,0.5"), "must be distinct", code=2)
-    assert_one_line_error(run("map", simulated[0], "--landmark-bands", "0.5", "--subsample", "knn"), "use maxmin",
-                          code=2)
-    assert_one_line_error(run("map", simulated[0], "--paper", "--landmark-bands", "1,0.5"),
-                          "--paper fixes --landmark-bands", code=2)
-    assert_one_line_error(run("map", simulated[0], "--window-scales", "1,0"), "distinct positive numbers", code=2)
-    assert_one_line_error(run("map", simulated[0], "--window-scales", "1,x"), "comma-separated", code=2)
-    assert_one_line_error(run("map", simulated[0], "--paper", "--window-scales", "1,2"),
-                          "--paper fixes --window-scales", code=2)
-    assert_one_line_error(run("map", simulated[0], "--paper", "--hop-cost", "1"), "--paper fixes --hop-cost", code=2)
-    assert_one_line_error(run("map", simulated[0], "--paper", "--diffusion-time", "1"),
-                          "--paper fixes --diffusion-time", code=2)
-    assert_one_line_error(run("map", simulated[0], "--window-length", "-3"), "positive number", code=2)
-    assert_one_line_error(run("map", simulated[0], "--diffusion-time", "0"), "positive number", code=2)
-    assert_one_line_error(run("map", simulated[0], "--paper", "--wall-follow-weight", "1"),
-                          "--paper fixes --wall-follow-weight", code=2)
-    assert_one_line_error(run("map", simulated[0], "--wall-follow-weight", "-1"), "must be a number in [0, 1e+06]", code=2)
-    assert_one_line_error(run("map", simulated[0], "--hop-cost", "-1"), "--hop-cost", code=2)
+    assert_one_line_errors(
+        *((("map", log, "--max-windows", bad), ("whole number >= 1",), 2) for bad in ("0", "-1", "2.5", "abc")),
+        (("map", log, "--max-windows", "2"), ("at least the number of window scales",), 2),
+        (("map", log, "--paper", "--max-windows", "5"), ("--paper fixes --max-windows",), 2),
+        (("map", log, "--landmark-bands", "1,1.5"), ("distinct numbers in (0, 1]",), 2),
+        (("map", log, "--landmark-bands", "0.5,x"), ("comma-separated",), 2),
+        (("map", log, "--landmark-bands", "0.5,0.5"), ("must be distinct",), 2),
+        (("map", log, "--landmark-bands", "0.5", "--subsample", "knn"), ("use maxmin",), 2),
+        (("map", log, "--paper", "--landmark-bands", "1,0.5"), ("--paper fixes --landmark-bands",), 2),
+        (("map", log, "--window-scales", "1,0"), ("distinct positive numbers",), 2),
+        (("map", log, "--window-scales", "1,x"), ("comma-separated",), 2),
+        (("map", log, "--paper", "--window-scales", "1,2"), ("--paper fixes --window-scales",), 2),
+        (("map", log, "--paper", "--hop-cost", "1"), ("--paper fixes --hop-cost",), 2),
+        (("map", log, "--paper", "--diffusion-time", "1"), ("--paper fixes --diffusion-time",), 2),
+        (("map", log, "--window-length", "-3"), ("positive number",), 2),
+        (("map", log, "--diffusion-time", "0"), ("positive number",), 2),
+        (("map", log, "--paper", "--wall-follow-weight", "1"), ("--paper fixes --wall-follow-weight",), 2),
+        (("map", log, "--wall-follow-weight", "-1"), ("must be a number in [0, 1e+06]",), 2),
+        (("map", log, "--hop-cost", "-1"), ("--hop-cost",), 2))
 
 
 def test_bench_and_plan_help_show_examples():
