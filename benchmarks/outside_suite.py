@@ -32,7 +32,7 @@ with the ``trace`` classifier; no plan figure is printed then: ``plan`` models l
 true count's ranks: the mean over cases of S_beta - ln tau_1 (the last true hole, beta the
 true beta_1; cases with a hole) and S_(beta+1) - ln tau_1 (the first noise rank), S_k
 pooled over that band's windows of the largest region, and how many cases' first noise
-rank passes (a hole too many if that band were read alone).
+rank passes ln tau_1 (the threshold of the vote that pools all bands).
 """
 
 from __future__ import annotations
@@ -117,7 +117,7 @@ def _arena(regime_name: str, regime: Regime, index: int):
 
 
 def _run(task):
-    regime_name, index, options, as_trace = task
+    regime_name, index, options, as_trace, band_scores = task
     regime = REGIMES[regime_name]
     arena, seed, family, area = _arena(regime_name, regime, index)
     motion = MotionParams(**regime.motion)
@@ -131,7 +131,7 @@ def _run(task):
     try:
         tmap = map_encounters(log, MapConfig(seed=seed % 2**32, embed_dim=0, cycles=False, **options))
         mapped, confidence = (tmap.betti[0], tmap.betti[1]), tmap.confidence[1]
-        margins = band_margins(tmap, arena.betti[1])
+        margins = band_margins(tmap, arena.betti[1]) if band_scores else {}
     except SwarmtopoError as error:  # a log the pipeline refuses is a wrong map, with its reason
         mapped, confidence = (str(error)[:80], None), None
     return {"regime": regime_name, "family": family, "area": area, "truth": tuple(arena.betti), "mapped": mapped,
@@ -180,7 +180,8 @@ def main() -> None:
     args = parser.parse_args()
     options = {k: v for text in args.set for k, v in config_override(text).items()}
     names = [n for n in REGIMES if any(n.startswith(p) for p in args.regimes)]
-    tasks = [(name, i, options, args.contact_trace) for name in names for i in range(args.first, args.first + args.per_regime)]
+    tasks = [(name, i, options, args.contact_trace, args.band_scores)
+             for name in names for i in range(args.first, args.first + args.per_regime)]
     with ProcessPoolExecutor(args.processes) as pool:
         results = list(pool.map(_run, tasks))
     plan = load_plan()
