@@ -20,11 +20,13 @@ log and seconds per map; then the reliability of the beta_1 confidence over all 
 regimes' maps (Brier score against a constant, and its bins).
 
     python benchmarks/outside_suite.py [--per-regime 12] [--first 0] [--regimes NAME ...] [--set FIELD=VALUE ...]
-                                       [--contact-trace] [--band-scores]
+                                       [--classifier NAME|FILE] [--contact-trace] [--band-scores]
 
 ``--first`` is the index of the first case of each regime (``--first 12`` the next
 twelve); ``--set`` maps with ``MapConfig`` fields changed (as
 ``benchmarks/levers.py``'s ``FIELD=VALUE`` variants: ``--set window_encounters=40``);
+``--classifier`` reads every map with a preset (``gated``) or a classifier file instead of
+the one ``map`` picks (its landmark bands too, when ``--set`` leaves them unset);
 ``--contact-trace`` maps each log's encounters only, as a real contact trace comes
 (``experiments.sweep.contact_trace``: no status, no r_d or speeds; ``map`` then reads it
 with the ``trace`` classifier; no plan figure is printed then: ``plan`` models log folders);
@@ -46,6 +48,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from swarmtopo.arena import HOLE_SHAPES, OUTER_SHAPES, random_arena
+from swarmtopo.classify import load_classifier
 from swarmtopo.errors import SwarmtopoError
 from swarmtopo.experiments.accuracy import ROOM_SIDE, Rate, reliability, reliability_bin_lines
 from swarmtopo.experiments.sweep import cached_classifier, contact_trace, stripped_log
@@ -117,7 +120,7 @@ def _arena(regime_name: str, regime: Regime, index: int):
 
 
 def _run(task):
-    regime_name, index, options, as_trace, band_scores = task
+    regime_name, index, options, classifier, as_trace, band_scores = task
     regime = REGIMES[regime_name]
     arena, seed, family, area = _arena(regime_name, regime, index)
     motion = MotionParams(**regime.motion)
@@ -129,7 +132,8 @@ def _run(task):
     start = time.perf_counter()
     margins = {}
     try:
-        tmap = map_encounters(log, MapConfig(seed=seed % 2**32, embed_dim=0, cycles=False, **options))
+        tmap = map_encounters(log, MapConfig(seed=seed % 2**32, embed_dim=0, cycles=False, **options),
+                              classifier=None if classifier is None else load_classifier(classifier))
         mapped, confidence = (tmap.betti[0], tmap.betti[1]), tmap.confidence[1]
         margins = band_margins(tmap, arena.betti[1]) if band_scores else {}
     except SwarmtopoError as error:  # a log the pipeline refuses is a wrong map, with its reason
@@ -175,12 +179,13 @@ def main() -> None:
     parser.add_argument("--regimes", nargs="*", default=list(REGIMES), help="regime names (a prefix is enough)")
     parser.add_argument("--set", nargs="*", default=[], metavar="FIELD=VALUE", help="MapConfig fields to change")
     parser.add_argument("--processes", type=int, default=2)
+    parser.add_argument("--classifier", default=None, help="a classifier preset or file to read every map with")
     parser.add_argument("--contact-trace", action="store_true", help="map the encounters only (a contact trace)")
     parser.add_argument("--band-scores", action="store_true", help="per band, the pooled scores' margins (docstring)")
     args = parser.parse_args()
     options = {k: v for text in args.set for k, v in config_override(text).items()}
     names = [n for n in REGIMES if any(n.startswith(p) for p in args.regimes)]
-    tasks = [(name, i, options, args.contact_trace, args.band_scores)
+    tasks = [(name, i, options, args.classifier, args.contact_trace, args.band_scores)
              for name in names for i in range(args.first, args.first + args.per_regime)]
     with ProcessPoolExecutor(args.processes) as pool:
         results = list(pool.map(_run, tasks))

@@ -15,7 +15,17 @@ exact count per cell against the default's score-only rule (its tau_1, kept in t
 file's provenance as ``score_only``) and the 4-fold cross-validated count, fits the
 confidence model on the same maps cross-fitted (gate refitted without each fold), and
 writes ``src/swarmtopo/data/classifier-gated.json`` (the ``gated`` preset).  Measured,
-it is not better than the default, which stays score-only (docs/accuracy.md).
+it is not better than the default on the suite (docs/accuracy.md).
+
+``--veto`` fits the default classifier's agreement veto instead: the default's score
+threshold (q_1, tau_1) is kept and b alone is fitted on the same maps
+(``experiments.tuning.fit_veto``: the strongest veto before the first b that breaks a
+tuning map), printed with the per-cell counts against the score alone, the 4-fold
+cross-validated count (b refitted without each fold) and the tuning count at every b
+from 0.6 up, and written into ``src/swarmtopo/data/classifier-default.json``
+(``thresholds.1.agreement``; provenance ``agreement_veto``).  The default's confidence is
+kept as ``scripts/tune_accuracy.py`` fitted it on the score alone (that script carries the
+veto over when it refits the default: rerun this one after it).
 
 ``--rule A [B]`` (repeatable) also prints, per cell, the count of a fixed rule: S_k > A
 (and A_k > B) on the same maps, without writing anything for it.
@@ -23,7 +33,7 @@ it is not better than the default, which stays score-only (docs/accuracy.md).
 Usage::
 
     python scripts/fit_agreement_gate.py [--store gate.duckdb] [--per-cell 24] [--sparse-per-cell 96] [--workers N]
-                                         [--rule 1.84 0.72 --rule 1.84]
+                                         [--rule 1.84 0.72 --rule 1.84] [--veto]
 """
 
 from __future__ import annotations
@@ -31,6 +41,7 @@ from __future__ import annotations
 import argparse
 import json
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -41,11 +52,13 @@ from swarmtopo.experiments.accuracy import (CELLS, HELD_OUT_FAMILY, PIPELINES, S
                                             tuning_session)
 from swarmtopo.experiments.store import job_rows
 from swarmtopo.experiments.sweep import run_sweep
-from swarmtopo.experiments.tuning import calibrated_classifier, cross_validated_exact, exact, fit_gate, maps_from_rows
+from swarmtopo.experiments.tuning import (B_GRID, calibrated_classifier, cross_validated_exact, exact, fit_gate,
+                                         fit_veto, maps_from_rows)
 from swarmtopo.ratio import RatioThresholds
 
 ROOT = Path(__file__).resolve().parent.parent
 TARGET = ROOT / "src" / "swarmtopo" / "data" / "classifier-gated.json"
+DEFAULT_TARGET = ROOT / "src" / "swarmtopo" / "data" / "classifier-default.json"
 FOLDS = 4
 
 
@@ -58,6 +71,8 @@ def main() -> None:
     parser.add_argument("--scheduler", default=None)
     parser.add_argument("--rule", nargs="+", type=float, action="append", default=[], metavar="A [B]",
                         help="also print the per-cell counts of the rule S_k > A (and A_k > B)")
+    parser.add_argument("--veto", action="store_true",
+                        help="fit the default classifier's agreement veto b (its tau_1 kept) and write it there")
     args = parser.parse_args()
     if any(len(rule) > 2 for rule in args.rule):
         parser.error("--rule takes A, or A and B")
@@ -76,6 +91,9 @@ def main() -> None:
     print(f"\n{summary}")
     rows = job_rows(args.store, jobs)
     maps = maps_from_rows(rows, cell_of)
+    if args.veto:
+        write_veto(shipped, score_only, maps, args, started)
+        return
     gate = fit_gate(maps, score_only.q)
     before, after = exact(maps, score_only), exact(maps, gate)
     print(f"{len(maps)} tuning maps ({len(rows) - len(maps)} refused); score only (q {score_only.q:g}, tau "
@@ -113,6 +131,42 @@ def main() -> None:
     print(f"confidence: {json.dumps(model.calibration_['1'])}")
     print(f"wrote {TARGET.relative_to(ROOT)} in {(time.perf_counter() - started) / 60:.1f} min")
 
+
+def write_veto(shipped, score_only: RatioThresholds, maps, args, started: float) -> None:
+    """``--veto``: fit b with the default's (q_1, tau_1), print it against the score alone and
+    write it into the default classifier (its confidence kept)."""
+    veto = fit_veto(maps, score_only)
+    before, after = exact(maps, score_only), exact(maps, veto)
+    chosen = []
+
+    def refit(subset):
+        chosen.append(fit_veto(subset, score_only))
+        return chosen[-1]
+
+    cv = cross_validated_exact(maps, folds=FOLDS, refit=refit)
+    print(f"{len(maps)} tuning maps; score only (q {score_only.q:g}, tau {score_only.tau:g}): {before.sum()}; "
+          f"veto b = {veto.agreement:g}: {after.sum()} ({np.sum(after & ~before)} fixed, {np.sum(before & ~after)} "
+          f"broken); {FOLDS}-fold cross-validated {cv.sum()}; the folds chose "
+          + ", ".join(f"{g.agreement:g}" for g in chosen))
+    per_cell = {}
+    for cell in CELLS:
+        inside = np.array([m.cell == cell.name for m in maps])
+        per_cell[cell.name] = {"score_only": int(before[inside].sum()), "veto": int(after[inside].sum()),
+                               "cross_validated": int(cv[inside].sum()), "maps": int(inside.sum())}
+        print(f"  {cell.name}: score only {before[inside].sum()}/{inside.sum()}, veto {after[inside].sum()}, "
+              f"cross-validated {cv[inside].sum()}")
+    by_b = {f"{b:g}": int(exact(maps, replace(score_only, agreement=float(b))).sum()) for b in B_GRID if b >= 0.6}
+    print("tuning count by b: " + ", ".join(f"{b}: {n}" for b, n in by_b.items()))
+    shipped.thresholds_ = {**shipped.thresholds_, 1: veto}
+    shipped.provenance_["agreement_veto"] = {
+        "b": veto.agreement, "rule": "the last b of the grid before the first that breaks a tuning map",
+        "script": "scripts/fit_agreement_gate.py --veto", "suite": SUITE,
+        "tuning_cases_per_cell": args.per_cell, "sparse_tuning_cases_per_cell": args.sparse_per_cell,
+        "tuning_maps": len(maps), "score_only_tuning_exact": float(before.mean()), "tuning_exact": float(after.mean()),
+        "cross_validated_exact": float(cv.mean()), "tuning_exact_by_b": by_b, "per_cell": per_cell,
+        "confidence": "the score-only fit's (scripts/tune_accuracy.py)", "swarmtopo": __version__}
+    shipped.save(DEFAULT_TARGET)
+    print(f"wrote {DEFAULT_TARGET.relative_to(ROOT)} in {(time.perf_counter() - started) / 60:.1f} min")
 
 if __name__ == "__main__":
     main()

@@ -485,6 +485,10 @@ def test_the_gate_reads_each_regions_cross_window_agreement():
     np.testing.assert_array_equal(strict.regions[0].agreement, a)
     assert lenient.betti[1] == score_only.betti[1]  # A_k > 0 for every passing rank: nothing vetoed
     assert strict.betti[1] == 0 and strict.regions[0].counted[1].size == 0  # every passing rank vetoed
+    # the vetoed ranks are named, with their A_k, in map.json and in the region's warnings
+    assert strict.regions[0].vetoed == tuple(range(1, score_only.betti[1] + 1)) and lenient.regions[0].vetoed == ()
+    assert any(f"A_k = {a[0]:.2f}" in w and "not counted" in w for w in strict.regions[0].warnings)
+    assert json.loads(json.dumps(strict.to_json()))["regions"][0]["vetoed"] == list(strict.regions[0].vetoed)
     # "always": A_k with any classifier, the vote unchanged; map.json lists it
     always = mapped(agreement="always")
     np.testing.assert_array_equal(always.regions[0].agreement, a)

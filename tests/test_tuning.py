@@ -8,8 +8,7 @@ import pytest
 
 from swarmtopo.experiments.tuning import (A_GRID, B_GRID, Q_GRID, TAU_GRID, TuningMap, calibrated_classifier,
                                          cross_fitted_features, cross_validated, exact, features_under, fit_gate,
-                                         fit_thresholds,
-                                         gate_estimates, grid_estimates)
+                                         fit_thresholds, fit_veto, gate_estimates, grid_estimates)
 from swarmtopo.persistence import Diagram
 from swarmtopo.ratio import CONFIDENCE_FEATURES, RatioClassifier, RatioThresholds
 
@@ -166,3 +165,19 @@ def test_the_gate_fit_vetoes_the_disagreeing_loop_the_score_alone_counts():
     bare = [dataclasses.replace(m, agreement=()) for m in maps]
     with pytest.raises(ValueError, match="agreement='always'"):
         gate_estimates(bare, 0.5)
+
+
+def test_the_veto_fit_keeps_the_score_threshold_and_takes_the_strongest_veto_that_breaks_no_map():
+    maps = gated_maps(30, np.random.default_rng(7))
+    score_only = RatioThresholds(0.5, float(np.exp(1.84)))
+    assert not exact(maps, score_only).any()  # every map counts the loop of ln 6.5-7 (A = 0.4) as a hole
+    veto = fit_veto(maps, score_only)
+    assert (veto.q, veto.tau) == (score_only.q, score_only.tau)
+    # from b = 0.4 the loop is vetoed; every hole has A = 0.9, so b stops just below it
+    assert exact(maps, veto).all() and veto.agreement == 0.88
+    assert not exact(maps, dataclasses.replace(veto, agreement=0.9)).all()
+    # a veto that breaks a map is not taken, whatever it fixes elsewhere: here the loop of
+    # A = 0.4 is a true hole of one map, right by the score alone
+    cost = dataclasses.replace(maps[0], true_betti1=maps[0].true_betti1 + 1)
+    assert exact([cost], score_only).all()
+    assert fit_veto(maps + [cost], score_only).agreement == 0.38

@@ -361,6 +361,7 @@ class RegionMap:
     windows: list[WindowMap]
     window: int  # index of the representative window
     agreement: np.ndarray | None = None  # A_1 .. A_5 (swarmtopo.agreement); None where not computed
+    vetoed: tuple[int, ...] = ()  # ranks k (1-based, as A_k) whose pooled score passed, vetoed by agreement
 
 
 @dataclass(eq=False)
@@ -458,6 +459,7 @@ class TopologicalMap:
                     "windows": [w.to_json() for w in r.windows],
                     "window": r.window,
                     "agreement": agreement_json(r.agreement),
+                    "vetoed": list(r.vetoed),
                     "diagrams": r.diagram.to_json(),
                     "mds_stress": None if r.embedding is None else float(r.embedding.stress),
                     "warnings": r.warnings,
@@ -671,6 +673,12 @@ def map_encounters(
         counted = {n: (region_classifier.counted_bars(chosen.diagram, n, count) if gated
                        else longest_bars(chosen.diagram, n, count)) for n, count in betti_region.items()}
         thresholds = classifier.length_thresholds(chosen.diagram)
+        vetoed = tuple(k + 1 for k in region_classifier.vetoed_.get(1, ()))
+        veto_note = [f"{len(vetoed)} loop(s) whose pooled score passed were not counted: not the same loop in the "
+                     "overlapping windows (A_k = " + ", ".join(f"{agreement[k - 1]:.2f}" for k in vetoed)
+                     + f" for rank(s) {', '.join(map(str, vetoed))}, at most b = "
+                     f"{classifier.thresholds_[1].agreement:g}); agents that follow walls for long leave such loops"
+                     ] if vetoed else []
         timings["classify"] += time.perf_counter() - t0
         say("embedding")
         t0 = time.perf_counter()
@@ -690,11 +698,12 @@ def map_encounters(
             betti=betti_region,
             confidence=confidence_region,
             cycles=[],
-            warnings=fallback + sampling,
+            warnings=fallback + sampling + veto_note,
             embedding=emb,
             windows=windows,
             window=rep,
             agreement=agreement,
+            vetoed=vetoed,
         ))
         if config.cycles:
             say("cycles")

@@ -13,7 +13,8 @@ the calibration grid's maps read the same way (:func:`features_under`).
 ``scripts/fit_agreement_gate.py`` fits the ``gated`` preset from the default's q_1: the
 agreement gate (:func:`fit_gate`: the score threshold a = ln tau_1 and the agreement
 threshold b, on tuning maps whose rows hold every region's A_k) and its confidence the
-same way.
+same way; with ``--veto`` it fits the default's agreement veto (:func:`fit_veto`: b
+alone, the default's (q_1, tau_1) kept: the strongest before the first b that breaks a tuning map).
 """
 
 from __future__ import annotations
@@ -166,19 +167,19 @@ def cross_validated(maps: Sequence[TuningMap], pooling: str = "mean", folds: int
     return int(cross_validated_exact(maps, pooling, folds).sum())
 
 
-def gate_estimates(maps: Sequence[TuningMap], q: float) -> np.ndarray:
-    """beta_hat_1 of every map at every (a, b) of the gate's grid, ``(len(maps), len(A_GRID), len(B_GRID))``:
+def gate_estimates(maps: Sequence[TuningMap], q: float, a_values: Sequence[float] = A_GRID) -> np.ndarray:
+    """beta_hat_1 of every map at every (a, b) of the gate's grid, ``(len(maps), len(a_values), len(B_GRID))``:
     #{k : S_k > a} minus the ranks k <= BARS among them with A_k <= b (NaN A_k vetoes nothing)."""
-    a = np.array(A_GRID)[:, None, None]
+    a = np.array(a_values)[:, None, None]
     b = np.array(B_GRID)[None, :, None]
-    est = np.zeros((len(maps), len(A_GRID), len(B_GRID)), np.int64)
+    est = np.zeros((len(maps), len(a_values), len(B_GRID)), np.int64)
     for k, m in enumerate(maps):
         for r, region in enumerate(m.regions):
             scores = pooled_scores(region, 1, q)
             est[k] += (scores[None, :] > a[:, :, 0]).sum(axis=1)[:, None]
             agreement = m.agreement[r] if len(m.agreement) > r else None
             if agreement is None:
-                if (scores[:BARS] > A_GRID[0]).any():
+                if (scores[:BARS] > min(a_values)).any():
                     raise ValueError("a tuning map without A_k: fit the gate on maps mapped with agreement='always'")
                 continue
             top = np.r_[scores[:BARS], np.zeros(BARS)][:BARS][None, None, :]
@@ -195,6 +196,31 @@ def fit_gate(maps: Sequence[TuningMap], q: float) -> RatioThresholds:
     smooth = uniform_filter(surface, size=3, mode="nearest")
     i, j = np.unravel_index(int(np.argmax(smooth + 1e-9 * surface)), surface.shape)
     return RatioThresholds(q, float(np.exp(A_GRID[i])), float(B_GRID[j]))
+
+
+def fit_veto(maps: Sequence[TuningMap], score_only: RatioThresholds) -> RatioThresholds:
+    """The agreement veto alone: ``score_only``'s (q_1, tau_1) kept, b the last of B_GRID
+    before the first at which some map that was right (at the b before, or by the score
+    alone) turns wrong.
+
+    The strongest veto the tuning maps do not pay for: raising b only drops ranks, so each
+    step can only fix maps that count too many or break maps whose holes agree little;
+    the gain lies beyond the suite (noise loops that are not the same loop from window to
+    window, docs/accuracy.md), where no b is chosen.
+    """
+    truth = np.array([m.true_betti1 for m in maps])
+    beta0 = np.array([m.est_betti0 == m.true_betti0 for m in maps])
+    est = gate_estimates(maps, score_only.q, (float(np.log(score_only.tau)),))[:, 0, :]
+    right = (est == truth[:, None]) & beta0[:, None]
+    before = exact(maps, score_only)
+    chosen = None
+    for j, b in enumerate(B_GRID):
+        if np.any(before & ~right[:, j]):
+            break
+        chosen, before = float(b), right[:, j]
+    if chosen is None:
+        raise ValueError("even the weakest veto of the grid breaks a tuning map")
+    return RatioThresholds(score_only.q, score_only.tau, chosen)
 
 
 def one_region(maps: Sequence[TuningMap]) -> list[TuningMap]:
