@@ -13,9 +13,7 @@ writes
   and on the calibration grid (``experiments.accuracy.calibration_jobs``: the planning
   grid's swarm sizes, durations and arenas with seeds of their own, mapped by the
   default pipeline), so that it holds beyond the suite's budgets (the ``gated``
-  classifier, ``scripts/fit_agreement_gate.py``, starts from its q_1 and tau_1; the
-  default's agreement veto b, fitted by that script's ``--veto`` on maps with A_k, is
-  carried over from the shipped file);
+  classifier, ``scripts/fit_agreement_gate.py``, starts from its q_1 and tau_1);
 * ``src/swarmtopo/data/classifier-trace.json``: the same for ``CHOSEN_TRACE``, the
   chosen pipeline reading the tuning cases as contact traces (encounters only), which
   ``map`` uses for a log without status changes; its confidence is calibrated on the
@@ -44,7 +42,6 @@ from __future__ import annotations
 
 import argparse
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -160,7 +157,7 @@ def main() -> None:
         raise SystemExit(f"MapConfig defaults differ from the chosen pipeline: {mismatch}; update swarmtopo/pipeline.py")
     for name in shipping if calibrate_only else ():
         fitted, shipped = results[SHIPPED[name]]["fit"].thresholds, load_classifier(name).thresholds_[1]
-        if fitted != replace(shipped, agreement=None):
+        if fitted != shipped:
             raise SystemExit(f"the tuning maps give {fitted} for {name}, the shipped classifier has {shipped}: "
                              "run without --calibrate-only to refit the classifiers")
     for name in shipping:
@@ -171,7 +168,6 @@ def main() -> None:
             "tuning_cases_per_cell": args.per_cell, "held_out_family": HELD_OUT_FAMILY,
             "tuning_maps": chosen["total"], "tuning_exact": chosen["right"] / chosen["total"], "swarmtopo": __version__},
             pooling=chosen["fit"].pooling, beyond=grid_maps[name])
-        _carry_veto(model, load_classifier(name))
         model.save(ROOT / "src" / "swarmtopo" / "data" / f"classifier-{name}.json")
         print(f"classifier-{name}.json: confidence {model.calibration_['1']} "
               f"({len(grid_maps[name])} calibration-grid maps); {confidence_readout(model)}")
@@ -239,19 +235,6 @@ def _write_doc(results, chosen, args, seconds, summary, job_minutes, transfer) -
               for c in CELLS]
     lines.append("")
     (ROOT / "docs" / "tuning.md").write_text("\n".join(lines), encoding="utf-8")
-
-
-def _carry_veto(model, shipped) -> None:
-    """Give the refitted ``model`` the shipped classifier's agreement veto b, if it has one
-    (fitted by ``scripts/fit_agreement_gate.py --veto`` on maps with A_k, which this
-    script's maps lack; the confidence stays the score alone's): tau_1 may have moved,
-    so refit b after a refit."""
-    b = shipped.thresholds_[1].agreement
-    if b is not None:
-        model.thresholds_ = {**model.thresholds_, 1: replace(model.thresholds_[1], agreement=b)}
-        model.provenance_["agreement_veto"] = {**shipped.provenance_.get("agreement_veto", {}),
-                                               "carried_over_by": "scripts/tune_accuracy.py"}
-        print(f"carried over the shipped agreement veto b = {b:g}: rerun scripts/fit_agreement_gate.py --veto")
 
 
 if __name__ == "__main__":

@@ -269,15 +269,11 @@ def test_bad_thresholds_and_files_are_input_errors():
                                    "thresholds": {"1": {"q": 0.5, "tau": 2.0}}})
 
 
-def test_shipped_default_is_a_calibrated_mean_pooled_ratio_classifier_with_a_veto_and_gated_its_gated_variant():
+def test_shipped_default_is_a_calibrated_mean_pooled_ratio_classifier_and_gated_its_gated_variant():
     model = load_classifier("default")
     assert isinstance(model, RatioClassifier) and model.pooling == "mean"
     assert set(model.calibration_) == {"1"}  # beta_0's confidence is the pipeline's (swarmtopo.beta0)
-    # the default vetoes loops that disagree across windows, at the b its fit recorded; traces read the score alone
-    veto = model.provenance_["agreement_veto"]
-    assert model.gated and model.thresholds_[1].agreement == veto["b"] and 0 < veto["b"] < 1
-    assert veto["tuning_exact"] >= veto["score_only_tuning_exact"]  # the rule: no tuning map broken
-    assert not load_classifier("trace").gated
+    assert not model.gated and not load_classifier("trace").gated  # the score alone
     gated = load_classifier("gated")
     assert gated.gated and 0 < gated.thresholds_[1].agreement < 1 and set(gated.calibration_) == {"1"}
     # fitted from the previous default's q_1 and tau_1 on its whole-window maps, which it reads with

@@ -3,9 +3,9 @@ r"""Cross-window cycle agreement: is a rank's loop the same loop in overlapping 
 A region's log is mapped in overlapping time windows (:mod:`swarmtopo.pipeline`).  A
 true hole is the same hole in every window, and consecutive windows share events; a
 noise loop of one window need not be a loop of the next.  A gated classifier
-(:class:`~swarmtopo.ratio.RatioClassifier` with an ``agreement`` threshold: the default,
-whose veto keeps its score threshold, and the ``gated`` preset, which lowers it) counts a
-rank k only if its pooled score passes *and* its agreement A_k does.
+(:class:`~swarmtopo.ratio.RatioClassifier` with an ``agreement`` threshold: the ``gated``
+preset; the default reads the score alone) counts a rank k only if its pooled score
+passes *and* its agreement A_k does.
 
 Circular coordinates (de Silva, Morozov and Vejdemo-Johansson 2011).  For each of a
 window's ``BARS`` longest H1 bars, its representative cocycle over Z/``PRIME`` (ripser.py)

@@ -413,12 +413,13 @@ def map_command(
         "auto", "--agreement",
         help="When to compute each region's cross-window cycle agreement A_1..A_5 (map.json regions[].agreement: "
              "is each of the longest loops the same loop in overlapping windows?): auto (default) where a gated "
-             "classifier (the default, gated) needs it, always for every region, to inspect."),
+             "classifier (--classifier gated) needs it, always for every region, to inspect."),
     classifier: Optional[str] = typer.Option(
         None, "--classifier",
         help="Betti classifier: default (tuned on the accuracy benchmark), trace (the same tuned on its logs read "
              "as contact traces), gated (a lower score threshold gated by cross-window cycle agreement, on whole-window "
-             "landmarks; measured, not better), paper-form (the paper's form trained our way), paper (the paper's "
+             "landmarks: better than the default where agents follow walls for tens of seconds, docs/accuracy.md), "
+             "paper-form (the paper's form trained our way), paper (the paper's "
              "Theta*), or a "
              "JSON file. Unset: default for a log with status changes, trace for one without."),
     paper: bool = typer.Option(

@@ -13,8 +13,9 @@ the calibration grid's maps read the same way (:func:`features_under`).
 ``scripts/fit_agreement_gate.py`` fits the ``gated`` preset from the default's q_1: the
 agreement gate (:func:`fit_gate`: the score threshold a = ln tau_1 and the agreement
 threshold b, on tuning maps whose rows hold every region's A_k) and its confidence the
-same way; with ``--veto`` it fits the default's agreement veto (:func:`fit_veto`: b
-alone, the default's (q_1, tau_1) kept: the strongest before the first b that breaks a tuning map).
+same way; with ``--veto`` it measures an agreement veto for the default (:func:`fit_veto`:
+b alone, the default's (q_1, tau_1) kept: the strongest before the first b that breaks a
+tuning map; not adopted, docs/accuracy.md).
 """
 
 from __future__ import annotations
