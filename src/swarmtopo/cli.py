@@ -417,8 +417,8 @@ def map_command(
     classifier: Optional[str] = typer.Option(
         None, "--classifier",
         help="Betti classifier: default (tuned on the accuracy benchmark), trace (the same tuned on its logs read "
-             "as contact traces), gated (a lower score threshold gated by cross-window cycle agreement, on whole-window "
-             "landmarks: better than the default where agents follow walls for tens of seconds, docs/accuracy.md), "
+             "as contact traces), gated (whole-window landmarks, a score threshold gated by cross-window cycle "
+             "agreement: better than the default where agents follow walls for tens of seconds, docs/accuracy.md), "
              "paper-form (the paper's form trained our way), paper (the paper's "
              "Theta*), or a "
              "JSON file. Unset: default for a log with status changes, trace for one without."),
