@@ -673,7 +673,7 @@ def map_encounters(
         counted = {n: (region_classifier.counted_bars(chosen.diagram, n, count) if gated
                        else longest_bars(chosen.diagram, n, count)) for n, count in betti_region.items()}
         thresholds = classifier.length_thresholds(chosen.diagram)
-        vetoed = tuple(k + 1 for k in region_classifier.vetoed_.get(1, ()))
+        vetoed = tuple(k + 1 for k in region_classifier.vetoed_.get(1, ())) if gated else ()
         veto_note = [f"{len(vetoed)} loop(s) whose pooled score passed were not counted: not the same loop in the "
                      "overlapping windows (A_k = " + ", ".join(f"{agreement[k - 1]:.2f}" for k in vetoed)
                      + f" for rank(s) {', '.join(map(str, vetoed))}, at most b = "
