@@ -48,7 +48,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from swarmtopo.arena import HOLE_SHAPES, OUTER_SHAPES, random_arena
-from swarmtopo.classify import load_classifier
 from swarmtopo.errors import SwarmtopoError
 from swarmtopo.experiments.accuracy import ROOM_SIDE, Rate, reliability, reliability_bin_lines
 from swarmtopo.experiments.sweep import cached_classifier, contact_trace, stripped_log
@@ -133,7 +132,7 @@ def _run(task):
     margins = {}
     try:
         tmap = map_encounters(log, MapConfig(seed=seed % 2**32, embed_dim=0, cycles=False, **options),
-                              classifier=None if classifier is None else load_classifier(classifier))
+                              classifier=None if classifier is None else cached_classifier(classifier, classifier))
         mapped, confidence = (tmap.betti[0], tmap.betti[1]), tmap.confidence[1]
         margins = band_margins(tmap, arena.betti[1]) if band_scores else {}
     except SwarmtopoError as error:  # a log the pipeline refuses is a wrong map, with its reason

@@ -39,7 +39,6 @@ from __future__ import annotations
 import argparse
 import json
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -51,7 +50,7 @@ from swarmtopo.experiments.accuracy import (CELLS, HELD_OUT_FAMILY, PIPELINES, S
 from swarmtopo.experiments.store import job_rows
 from swarmtopo.experiments.sweep import run_sweep
 from swarmtopo.experiments.tuning import (B_GRID, calibrated_classifier, cross_validated_exact, exact, fit_gate,
-                                         fit_veto, maps_from_rows)
+                                         fit_veto, maps_from_rows, veto_right)
 from swarmtopo.ratio import RatioThresholds
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -148,8 +147,9 @@ def report_veto(score_only: RatioThresholds, maps) -> None:
         inside = np.array([m.cell == cell.name for m in maps])
         print(f"  {cell.name}: score only {before[inside].sum()}/{inside.sum()}, veto {after[inside].sum()}, "
               f"cross-validated {cv[inside].sum()}")
-    print("tuning count by b: " + ", ".join(
-        f"{b:g}: {exact(maps, replace(score_only, agreement=float(b))).sum()}" for b in B_GRID if b >= 0.6))
+    counts = veto_right(maps, score_only).sum(axis=0)
+    print("tuning count by b: " + ", ".join(f"{b:g}: {n}" for b, n in zip(B_GRID, counts) if b >= 0.6))
+
 
 if __name__ == "__main__":
     main()

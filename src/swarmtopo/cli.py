@@ -419,9 +419,8 @@ def map_command(
         help="Betti classifier: default (tuned on the accuracy benchmark), trace (the same tuned on its logs read "
              "as contact traces), gated (whole-window landmarks, a score threshold gated by cross-window cycle "
              "agreement: better than the default where agents follow walls for tens of seconds, docs/accuracy.md), "
-             "paper-form (the paper's form trained our way), paper (the paper's "
-             "Theta*), or a "
-             "JSON file. Unset: default for a log with status changes, trace for one without."),
+             "paper-form (the paper's form trained our way), paper (the paper's Theta*), or a JSON file. Unset: "
+             "default for a log with status changes, trace for one without."),
     paper: bool = typer.Option(
         False, "--paper",
         help="Run exactly the paper's pipeline: no per-hop cost, no diffusive weights, wall following like any "

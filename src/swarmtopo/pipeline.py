@@ -674,11 +674,7 @@ def map_encounters(
                        else longest_bars(chosen.diagram, n, count)) for n, count in betti_region.items()}
         thresholds = classifier.length_thresholds(chosen.diagram)
         vetoed = tuple(k + 1 for k in region_classifier.vetoed_.get(1, ())) if gated else ()
-        veto_note = [f"{len(vetoed)} loop(s) whose pooled score passed were not counted: not the same loop in the "
-                     "overlapping windows (A_k = " + ", ".join(f"{agreement[k - 1]:.2f}" for k in vetoed)
-                     + f" for rank(s) {', '.join(map(str, vetoed))}, at most b = "
-                     f"{classifier.thresholds_[1].agreement:g}); agents that follow walls for long leave such loops"
-                     ] if vetoed else []
+        veto_note = [_veto_warning(vetoed, agreement, classifier.thresholds_[1].agreement)] if vetoed else []
         timings["classify"] += time.perf_counter() - t0
         say("embedding")
         t0 = time.perf_counter()
@@ -744,6 +740,14 @@ def map_encounters(
         contact_trace=shipped_classifier_for(log) == "trace",
         software=software_versions(),
     )
+
+
+def _veto_warning(vetoed: tuple[int, ...], agreement: np.ndarray, b: float) -> str:
+    """The region warning naming the ranks k (1-based) its agreement A_k <= b vetoed."""
+    values = ", ".join(f"{agreement[k - 1]:.2f}" for k in vetoed)
+    return (f"{len(vetoed)} loop(s) whose pooled score passed were not counted: not the same loop in the "
+            f"overlapping windows (A_k = {values} for rank(s) {', '.join(map(str, vetoed))}, at most b = {b:g}); "
+            "agents that follow walls for long leave such loops")
 
 
 def _timed_knn_scale(sub: EncounterGraph, config: MapConfig, timings: dict[str, float]) -> float:

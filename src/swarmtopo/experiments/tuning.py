@@ -188,12 +188,23 @@ def gate_estimates(maps: Sequence[TuningMap], q: float, a_values: Sequence[float
     return est
 
 
+def gate_right(maps: Sequence[TuningMap], q: float, a_values: Sequence[float] = A_GRID) -> np.ndarray:
+    """Whether each map is exactly right at every (a, b) of :func:`gate_estimates`' grid."""
+    truth = np.array([m.true_betti1 for m in maps])
+    beta0 = np.array([m.est_betti0 == m.true_betti0 for m in maps])
+    return (gate_estimates(maps, q, a_values) == truth[:, None, None]) & beta0[:, None, None]
+
+
+def veto_right(maps: Sequence[TuningMap], score_only: RatioThresholds) -> np.ndarray:
+    """``(len(maps), len(B_GRID))``: whether each map is exactly right with ``score_only``'s
+    (q_1, tau_1) and a veto at every b of the grid."""
+    return gate_right(maps, score_only.q, (float(np.log(score_only.tau)),))[:, 0, :]
+
+
 def fit_gate(maps: Sequence[TuningMap], q: float) -> RatioThresholds:
     """The gate (tau_1 = e^a, b) at the grid point whose mean exact rate over itself and
     its neighbours in a and b (3 x 3, edges repeated) is highest (ties: the first)."""
-    truth = np.array([m.true_betti1 for m in maps])
-    beta0 = np.array([m.est_betti0 == m.true_betti0 for m in maps])
-    surface = ((gate_estimates(maps, q) == truth[:, None, None]) & beta0[:, None, None]).mean(axis=0)
+    surface = gate_right(maps, q).mean(axis=0)
     smooth = uniform_filter(surface, size=3, mode="nearest")
     i, j = np.unravel_index(int(np.argmax(smooth + 1e-9 * surface)), surface.shape)
     return RatioThresholds(q, float(np.exp(A_GRID[i])), float(B_GRID[j]))
@@ -209,10 +220,7 @@ def fit_veto(maps: Sequence[TuningMap], score_only: RatioThresholds) -> RatioThr
     the gain lies beyond the suite (noise loops that are not the same loop from window to
     window, docs/accuracy.md), where no b is chosen.
     """
-    truth = np.array([m.true_betti1 for m in maps])
-    beta0 = np.array([m.est_betti0 == m.true_betti0 for m in maps])
-    est = gate_estimates(maps, score_only.q, (float(np.log(score_only.tau)),))[:, 0, :]
-    right = (est == truth[:, None]) & beta0[:, None]
+    right = veto_right(maps, score_only)
     before = exact(maps, score_only)
     chosen = None
     for j, b in enumerate(B_GRID):
