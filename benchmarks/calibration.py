@@ -19,14 +19,22 @@ fitted on those maps); the ``gated`` preset's confidence
 is fitted on its own tuning maps by ``scripts/fit_agreement_gate.py`` (the shipped file on z).
 
 Feature sets: ``z`` (how many standard errors the pooled scores are from changing the
-vote, ``ratio.standardised_margin``; the previous calibration); z and the windows'
-resolution ln L (``ratio.resolution``); those and z ln L (shipped); those and ln #windows;
-the calibration before z (agreement of the windows with the vote, log margin, ln #windows).
+vote, ``ratio.standardised_margin``); z and the windows' resolution ln L
+(``ratio.resolution``); those and z ln L (shipped); those and ln #windows; those and the
+region's span ln T (the seconds its windows cover, ``ratio.windows_span``); those and z
+ln T (measured, not adopted: docs/accuracy.md); the calibration before z (agreement of
+the windows with the vote, log margin, ln #windows).
 Each is fitted on both sets; then how often a draw of the reporting suite's size
 (390 maps) from the tuning maps shows the shipped features no better than the constant;
-last, z fitted on the tuning maps alone, as before the grid.
+last, z fitted on the tuning maps alone, as before the grid.  With ``--planning-store``
+(a store of ``swarmtopo bench accuracy``'s full run, which maps the planning grid: the
+calibration grid's cells with seeds of their own), each feature set is also fitted on
+all tuning and calibration-grid maps at once, as the shipped calibration is, and scored
+on the planning grid's one-region maps read with the thresholds fitted on the tuning maps:
+a check on maps no model or threshold was fitted on.
 
     python benchmarks/calibration.py [--store tuning.duckdb] [--reading contact-trace]
+                                     [--planning-store full.duckdb]
 """
 
 from __future__ import annotations
@@ -45,13 +53,15 @@ from swarmtopo.experiments.sweep import INPUTS, map_input
 from swarmtopo.experiments.tuning import (cross_fitted_features, features_under, fit_thresholds, job_pipeline,
                                          maps_from_rows, pipeline_fields)
 from swarmtopo.pipeline import MapConfig
-from swarmtopo.ratio import CONFIDENCE_FEATURES, confidence_design, confidence_model
+from swarmtopo.ratio import CONFIDENCE_FEATURES, SPAN_FEATURES, confidence_design, confidence_model
 
 FEATURE_SETS = {
-    "z (previous)": ("z",),
+    "z": ("z",),
     "z, resolution": ("z", "resolution"),
     "z, resolution, z x resolution (shipped)": CONFIDENCE_FEATURES,
     "z, resolution, z x resolution, ln windows": (*CONFIDENCE_FEATURES, "windows"),
+    "z, resolution, z x resolution, ln span": (*CONFIDENCE_FEATURES, "log_span"),
+    "z, resolution, z x resolution, ln span, z x ln span": (*CONFIDENCE_FEATURES, *SPAN_FEATURES),
     "agreement, margin, ln windows (before z)": ("agreement", "margin", "windows"),
 }
 COLUMNS = ("key", "sweep", "config", "replicate", "diagrams", "error", "est_betti0", "true_betti0", "true_betti1")
@@ -60,11 +70,12 @@ COLUMNS = ("key", "sweep", "config", "replicate", "diagrams", "error", "est_bett
 def default_maps(store: str, reading: str = "log", split: str = "tuning"):
     """The maps of the pipeline whose options are MapConfig's defaults, reading the whole
     log folder (``reading`` "log") or its contact trace ("contact-trace"), in job order:
-    the tuning cases (``split`` "tuning") or the calibration grid ("calibration")."""
+    the tuning cases (``split`` "tuning"), the calibration grid ("calibration") or the
+    planning grid ("planning")."""
     defaults = pipeline_fields(MapConfig(), load_classifier("trace" if reading == "contact-trace" else "default"))
     rows = [r for r in read_jobs(store, columns=COLUMNS) if map_input(r["config"]["map"]) == reading
             and r["sweep"].startswith(f"accuracy-{split}-") and job_pipeline(r["config"]["map"]) == defaults]
-    cells = PLANNING_CELLS if split == "calibration" else CELLS
+    cells = CELLS if split == "tuning" else PLANNING_CELLS
     name = partial(cell_of, cells=cells)
     rows.sort(key=lambda r: (r["replicate"], name(r["config"])))
     return maps_from_rows(rows, name)
@@ -95,11 +106,15 @@ def main() -> None:
     parser.add_argument("--store", default="tuning.duckdb", help="a store written by scripts/tune_accuracy.py")
     parser.add_argument("--reading", choices=INPUTS, default="log",
                         help="the maps of log folders (default classifier) or of contact traces (trace classifier)")
+    parser.add_argument("--planning-store", help="a store of swarmtopo bench accuracy's full run: score each feature "
+                                                 "set, fitted on every tuning and calibration-grid map, on its "
+                                                 "planning grid")
     args = parser.parse_args()
     maps, grid = default_maps(args.store, args.reading), default_maps(args.store, args.reading, split="calibration")
     print(f"at most {max(len(region) for m in maps for region in m.regions)} windows per region")
     features, correct = cross_fitted_features(maps, "mean")
-    grid_features, grid_correct = features_under(grid, fit_thresholds(maps, "mean").thresholds, "mean")
+    thresholds = fit_thresholds(maps, "mean").thresholds
+    grid_features, grid_correct = features_under(grid, thresholds, "mean")
     y = np.array(correct + grid_correct)
     on_grid = np.arange(len(y)) >= len(correct)
     print(f"{args.store}: {len(maps)} default-pipeline tuning maps ({args.reading}), {len(correct)} with one region, "
@@ -119,6 +134,15 @@ def main() -> None:
                               method="predict_proba")[:, 1]
     print("\n## z fitted on the tuning maps alone (the calibration before the grid)")
     _scores("tuning maps", y[~on_grid], alone)
+    if args.planning_store:
+        planning = default_maps(args.planning_store, args.reading, split="planning")
+        held_features, held_correct = features_under(planning, thresholds, "mean")
+        print(f"\n## fitted on all {len(y)} maps above, scored on {args.planning_store}'s planning grid "
+              f"({len(planning)} maps, {len(held_correct)} with one region, {held_correct.count(False)} wrong)")
+        for name, columns in FEATURE_SETS.items():
+            model = confidence_model().fit(confidence_design(features + grid_features, columns), y)
+            p = model.predict_proba(confidence_design(held_features, columns))[:, 1]
+            _scores(name, np.array(held_correct), p)
 
 
 if __name__ == "__main__":

@@ -12,7 +12,8 @@ from scipy.special import expit
 
 from swarmtopo.pipeline import MapConfig, fitted_landmark_bands
 from swarmtopo.ratio import (LOG_RATIO_CAP, MAX_MARGIN, RESOLUTION_CAP, SCORE_VAR_PRIOR, Z_CAP, RatioClassifier,
-                             RatioThresholds, below_full_resolution, confidence_readout, longest_bars, median_vote, pooled_scores, region_reader, resolution,
+                             RatioThresholds, SPAN_FEATURES, below_full_resolution, calibrated_probability, confidence_readout,
+                             longest_bars, median_vote, pooled_scores, region_reader, resolution, windows_span,
                              score_matrix, score_margin, standardised_margin, vote, window_scores)
 
 TH = RatioThresholds(q=0.5, tau=2.0)
@@ -171,6 +172,29 @@ def test_a_calibration_of_z_and_resolution_is_applied_as_fitted_and_one_of_z_alo
     z_only = RatioClassifier({1: TH}, calibration={"1": {"intercept": -3.0, "z": 1.2}})
     assert z_only.region_confidence(sparse)[1] == z_only.region_confidence(fine)[1] == pytest.approx(
         expit(-3.0 + 1.2 * z))
+
+
+def test_the_span_features_are_ln_t_and_z_ln_t_and_a_calibration_never_reads_a_missing_feature_as_zero():
+    model = RatioClassifier({1: TH}, calibration={"1": {"intercept": -3.0, "z": 1.2, "resolution": 0.5,
+                                                        "z_x_resolution": 0.25, "maps": 10}})
+    windows = [with_landmarks(20)] * 3
+    plain = model.region_features(windows, 1)
+    spanned = model.region_features(windows, 1, span=45.0)
+    assert not set(SPAN_FEATURES) & set(plain)
+    assert spanned["log_span"] == pytest.approx(np.log(45.0))
+    assert spanned["z_x_log_span"] == pytest.approx(plain["z"] * np.log(45.0))
+    assert {k: v for k, v in spanned.items() if k not in SPAN_FEATURES} == plain
+    with pytest.raises(ValueError, match="weighs resolution, z_x_resolution, which the region's features lack"):
+        calibrated_probability(model.calibration_["1"], {"z": plain["z"]})
+    with pytest.raises(InputError, match="unknown confidence feature.*log_span"):  # no file weighs the span
+        RatioClassifier({1: TH}, calibration={"1": {"intercept": 0.0, "z": 1.0, "log_span": 0.1}})
+
+
+def test_windows_span_is_the_first_start_to_the_last_end():
+    records = [{"t0": 5.0, "t1": 20.0, "band": 1.0}, {"t0": 0.0, "t1": 15.0, "band": 0.5},
+               {"t0": 10.0, "t1": 25.0, "band": 1.0}]
+    assert windows_span(records) == 25.0
+    assert windows_span(records[1:2]) == 15.0
 
 
 def test_median_vote_is_the_lower_median():

@@ -8,7 +8,7 @@ import pytest
 
 from swarmtopo.experiments.tuning import (A_GRID, B_GRID, Q_GRID, TAU_GRID, TuningMap, calibrated_classifier,
                                          cross_fitted_features, cross_validated, exact, features_under, fit_gate,
-                                         fit_thresholds, fit_veto, gate_estimates, grid_estimates)
+                                         fit_thresholds, maps_from_rows, fit_veto, gate_estimates, grid_estimates)
 from swarmtopo.persistence import Diagram
 from swarmtopo.ratio import CONFIDENCE_FEATURES, RatioClassifier, RatioThresholds
 
@@ -181,3 +181,17 @@ def test_the_veto_fit_keeps_the_score_threshold_and_takes_the_strongest_veto_tha
     cost = dataclasses.replace(maps[0], true_betti1=maps[0].true_betti1 + 1)
     assert exact([cost], score_only).all()
     assert fit_veto(maps + [cost], score_only).agreement == 0.38
+
+
+def test_maps_know_their_regions_spans_and_their_features_carry_the_span():
+    rng = np.random.default_rng(6)
+    (one,) = synthetic_maps(1, rng)
+    row = {"error": None, "est_betti0": 1, "true_betti0": 1, "true_betti1": one.true_betti1, "config": {},
+           "diagrams": [{"windows": [{"t0": 2.0 + 10 * k, "t1": 17.0 + 10 * k, "band": band, "diagram": w.to_json()}
+                                     for k, w in enumerate(one.regions[0]) for band in (1.0, 0.5)]}]}
+    (read,) = maps_from_rows([row], lambda config: "c")
+    assert read.spans == (35.0,) and len(read.regions) == 1 and len(read.regions[0]) == 6
+    th = RatioThresholds(0.5, 3.0)
+    (features,), _ = features_under([read], th)
+    assert features == RatioClassifier({1: th}).region_features(read.regions[0], 1, span=35.0)
+    assert features["log_span"] == pytest.approx(np.log(35.0))

@@ -98,6 +98,10 @@ RESOLUTION_CAP = 400
 ``--max-landmarks`` does not read as a resolution never calibrated."""
 CONFIDENCE_FEATURES = ("z", "resolution", "z_x_resolution")
 """The features :meth:`RatioClassifier.calibrate` fits."""
+SPAN_FEATURES = ("log_span", "z_x_log_span")
+"""ln T and z ln T, T the seconds a region's windows cover (:func:`windows_span`): candidate
+features ``benchmarks/calibration.py`` measures (not adopted, docs/accuracy.md); no
+calibration file weighs them."""
 OLD_FEATURES = ("agreement", "margin", "windows")
 """The features of files calibrated before z existed."""
 REGION_FEATURES = (*CONFIDENCE_FEATURES, *OLD_FEATURES)
@@ -151,6 +155,12 @@ def resolution(windows: Sequence[Diagram]) -> float:
     return float(np.mean([np.log(max(1, min(len(w[0]), RESOLUTION_CAP))) for w in windows]))
 
 
+def windows_span(windows: Sequence[dict[str, Any]]) -> float:
+    """T, the seconds a region's windows cover: the last window's end minus the first one's
+    start (their stored records' ``t0`` and ``t1``)."""
+    return float(max(w["t1"] for w in windows) - min(w["t0"] for w in windows))
+
+
 def below_full_resolution(windows: Sequence[Diagram]) -> bool:
     """Whether the windows average fewer than RESOLUTION_CAP landmarks (in log units, so
     that windows all at the cap are at full resolution)."""
@@ -170,10 +180,14 @@ def confidence_readout(classifier: "RatioClassifier", landmarks: Sequence[int] =
 
 
 def calibrated_probability(model: dict[str, float], features: dict[str, float]) -> float:
-    """P(right) of a fitted calibration ``model`` (intercept and one coefficient per
-    feature it weighs) at ``features``: expit(intercept + sum of coefficient x feature)."""
-    return float(expit(model["intercept"] + sum(coef * features[name] for name, coef in model.items()
-                                                 if name in features)))
+    """P(right) of a fitted calibration ``model`` (intercept, maps and one coefficient per
+    feature it weighs) at ``features``: expit(intercept + sum of coefficient x feature).
+    A feature it weighs that ``features`` lacks is an error, not a zero."""
+    weighed = {name: coef for name, coef in model.items() if name not in ("intercept", "maps")}
+    missing = sorted(set(weighed) - set(features))
+    if missing:
+        raise ValueError(f"the confidence calibration weighs {', '.join(missing)}, which the region's features lack")
+    return float(expit(model["intercept"] + sum(coef * features[name] for name, coef in weighed.items())))
 
 
 def confidence_model() -> LogisticRegression:
@@ -427,10 +441,12 @@ class RatioClassifier:
         return {n: count_above(self.score_matrix(windows, n).mean(axis=0), th.tau)
                 for n, th in self.thresholds_.items() if n <= maxdim}
 
-    def region_features(self, windows: Sequence[Diagram], n: int, voted=None) -> dict[str, float]:
+    def region_features(self, windows: Sequence[Diagram], n: int, voted=None,
+                        span: float | None = None) -> dict[str, float]:
         """One region's confidence features for dimension n: z, the resolution ln L and their
         product (module docstring), and the agreement, capped log margin and ln #windows that
-        older calibrations use.
+        older calibrations use; given ``span`` (the seconds T its windows cover) also the
+        measured candidates ln T and z ln T (SPAN_FEATURES).
         ``voted`` is :func:`vote`'s result for these windows when the caller has it."""
         betti, rep, counts = voted or vote(self, windows)
         th = self.thresholds_[n]
@@ -440,9 +456,13 @@ class RatioClassifier:
         else:
             margin = score_margin(matrix.mean(axis=0), th.tau)
         z, ln_l = standardised_margin(matrix, betti[n], th.tau), resolution(windows)
-        return {"z": z, "resolution": ln_l, "z_x_resolution": z * ln_l,
-                "agreement": float(np.mean(np.asarray(counts[n]) == betti[n])),
-                "margin": margin, "windows": float(np.log(len(windows)))}
+        features = {"z": z, "resolution": ln_l, "z_x_resolution": z * ln_l,
+                    "agreement": float(np.mean(np.asarray(counts[n]) == betti[n])),
+                    "margin": margin, "windows": float(np.log(len(windows)))}
+        if span is not None:
+            ln_t = float(np.log(span))
+            features |= {"log_span": ln_t, "z_x_log_span": z * ln_t}
+        return features
 
     def region_confidence(self, windows: Sequence[Diagram], voted=None) -> dict[int, float | None]:
         """P(the region's beta_hat_n is right) from the calibrated model; None if uncalibrated.

@@ -29,7 +29,8 @@ from scipy.ndimage import uniform_filter, uniform_filter1d
 from ..persistence import Diagram
 from ..agreement import BARS, agreement_array
 from ..pipeline import MapConfig, resolve_landmark_bands
-from ..ratio import CONFIDENCE_FEATURES, RatioClassifier, RatioThresholds, pooled_scores, region_reader, window_scores
+from ..ratio import (CONFIDENCE_FEATURES, RatioClassifier, RatioThresholds, pooled_scores, region_reader, window_scores,
+                     windows_span)
 from .sweep import cached_classifier, job_classifier, job_map_config
 
 Q_GRID = (0.5, 0.6, 0.7, 0.8, 0.9)
@@ -66,6 +67,7 @@ class TuningMap:
     true_betti1: int
     cell: str
     agreement: tuple[np.ndarray | None, ...] = ()  # each region's A_1 .. A_BARS, None where not computed
+    spans: tuple[float, ...] = ()  # each region's windows' span T in seconds (ratio.windows_span); () unknown
 
 
 def maps_from_rows(rows: Sequence[dict[str, Any]], cell_of) -> list[TuningMap]:
@@ -83,7 +85,8 @@ def maps_from_rows(rows: Sequence[dict[str, Any]], cell_of) -> list[TuningMap]:
         agreement = tuple(None if region.get("agreement") is None else agreement_array(region["agreement"])
                           for region in row["diagrams"])
         maps.append(TuningMap(regions, int(row["est_betti0"]), int(row["true_betti0"]), int(row["true_betti1"]),
-                              cell_of(row["config"]), agreement))
+                              cell_of(row["config"]), agreement,
+                              tuple(windows_span(region["windows"]) for region in row["diagrams"])))
     return maps
 
 
@@ -240,11 +243,13 @@ def one_region(maps: Sequence[TuningMap]) -> list[TuningMap]:
 
 def features_under(maps: Sequence[TuningMap], th: RatioThresholds,
                    pooling: str = "mean") -> tuple[list[dict[str, float]], list[bool]]:
-    """Confidence features (:meth:`~swarmtopo.ratio.RatioClassifier.region_features`) and
-    outcomes of the one-region ``maps`` read with thresholds ``th``."""
+    """Confidence features (:meth:`~swarmtopo.ratio.RatioClassifier.region_features`, with
+    the span's where the map knows it) and outcomes of the one-region ``maps`` read with
+    thresholds ``th``."""
     single = one_region(maps)
     model = RatioClassifier({1: th}, pooling=pooling)
-    return ([_reader(model, m, 0).region_features(m.regions[0], 1) for m in single],
+    return ([_reader(model, m, 0).region_features(m.regions[0], 1, span=m.spans[0] if m.spans else None)
+             for m in single],
             [bool(ok) for ok in exact(single, th, pooling)])
 
 
