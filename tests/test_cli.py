@@ -397,7 +397,8 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     assert [w["band"] for w in doc["regions"][0]["windows"]][:2] == [1.0, 0.5]
     assert_one_line_errors(
         *((("map", log, "--max-windows", bad), ("whole number >= 1",), 2) for bad in ("0", "-1", "2.5", "abc")),
-        (("map", log, "--max-windows", "2"), ("at least the number of window scales",), 2),
+        (("map", log, "--max-windows", "2"), ("--max-windows must be a whole number, at least the number of "
+                                               "window scales (3: one window per length), or 'none'; got 2",), 2),
         (("map", log, "--paper", "--max-windows", "5"), ("--paper fixes --max-windows",), 2),
         (("map", log, "--landmark-bands", "1,1.5"), ("distinct numbers in (0, 1]",), 2),
         (("map", log, "--landmark-bands", "0.5,x"), ("comma-separated",), 2),

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import gzip
 import json
+import os
 import subprocess
 import sys
 
@@ -326,6 +327,28 @@ def test_parquet_nulls_and_nan_ids_are_missing_values_and_text_is_kept_exactly(t
     pq.write_table(pa.table({" t": [1.0, 2.0], "a ": [" 1", "1 "], "b": ["2", "2"]}), path)
     log, _ = ingest(path, "parquet")  # names found as in CSV headers; values not trimmed: two agents
     assert events(log) == [(1.0, " 1", "2"), (2.0, "1 ", "2")]
+
+
+def test_parquet_float_ids_minus_zero_is_agent_zero_as_map_reads_it(tmp_path):
+    path = tmp_path / "trace.parquet"
+    pq.write_table(pa.table({"t": [1.0, 2.0, 3.0], "a": [0.0, 1.0, -0.0], "b": [1.0, 2.0, 2.0]}), path)
+    log, _ = ingest(path, "parquet")
+    assert events(log) == [(1.0, "0", "1"), (2.0, "1", "2"), (3.0, "0", "2")] and log.agent_ids.dtype.kind == "i"
+    pq.write_table(pa.table({"t": [1.0, 2.0, 3.0], "a": [0.0, 1.0, -0.0], "b": [1.0, 2.0, 2.0]}),
+                   tmp_path / "events.parquet")
+    assert read_log(tmp_path).agent_ids.tolist() == [0, 1, 2]
+
+
+def test_ids_holding_a_nul_and_traces_that_are_not_regular_files_are_refused(tmp_path):
+    path = tmp_path / "trace.parquet"
+    pq.write_table(pa.table({"t": [1.0, 2.0, 3.0], "a": ["x", "y", "x\x00"], "b": ["y", "z", "z"]}), path)
+    with pytest.raises(InputError, match="NUL") as caught:
+        ingest(path, "parquet")
+    assert (caught.value.row, caught.value.column, caught.value.value) == (3, "a", "x\x00")
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)  # as /dev/stdin is when a trace is piped in: never opened, so never blocks
+    with pytest.raises(InputError, match="not a regular file.*save it to a file first"):
+        ingest(fifo, "csv")
 
 
 @pytest.mark.parametrize("ids", [["B7", "B7 ", "B8"], ["B12  ", "B13  ", "B1   "]])

@@ -151,6 +151,16 @@ def test_non_integer_float_id():
     assert (err.row, err.column, err.value) == (2, "a", 2.5)
 
 
+def test_text_ids_holding_a_nul_are_refused_not_merged():
+    # numpy strings drop trailing NULs: 'a7\x00' would be agent 'a7'
+    for ids in (np.array(["a7", "a8", "a7\x00"], dtype=object), pa.array(["a7", "a8", "a7\x00"])):
+        err = error_of([0.0, 1.0, 2.0], ids, ["b1", "b2", "b3"])
+        assert (err.file, err.row, err.column, err.value) == ("ev.csv", 3, "a", "a7\x00")
+        assert "NUL" in err.reason
+    err = error_of([0.0], ["a"], pa.array(["b\x00c"]))  # inside an ID too
+    assert (err.row, err.column) == (1, "b")
+
+
 def test_float_ids_beyond_int64_are_refused_not_wrapped():
     # 1e20 and 2e20 would both cast to -2^63: one agent
     for ids in (np.array([1.0, 1e20]), pa.array([1.0, 1e20])):

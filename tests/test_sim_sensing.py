@@ -173,6 +173,19 @@ def test_wall_grid_lists_exactly_the_segments_within_reach_of_each_cell(seed, ce
     assert pairs == _literal_wall_grid_pairs(arena.boundary_segments, arena.bounds, cell, reach)
 
 
+def test_a_reach_beyond_the_arena_lists_every_wall_in_its_one_cell_without_overflow():
+    import warnings
+
+    from swarmtopo.arena import random_arena
+    from swarmtopo.sim.walls import build_wall_grid
+
+    arena = random_arena(2, rng=4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a reach of 1e300 used to overflow in shapely's dwithin
+        grid = build_wall_grid(arena.boundary_segments, arena.bounds, cell=1e300, reach=1e300)
+    assert grid.ncx == grid.ncy == 1 and sorted(grid.index.tolist()) == list(range(len(arena.boundary_segments)))
+
+
 def test_a_large_arena_builds_its_wall_grid_along_the_walls_and_an_absurd_one_is_refused():
     from swarmtopo.arena import square_arena
     from swarmtopo.errors import SwarmtopoError

@@ -7,6 +7,7 @@ exit code 1; usage errors exit 2 (Typer); only bugs produce a traceback.
 from __future__ import annotations
 
 import math
+import re
 import sys
 from contextlib import contextmanager
 from pathlib import Path
@@ -348,6 +349,19 @@ def _parse_bands(text: Optional[str]):
     return bands
 
 
+MAP_CONFIG_OPTIONS = ("--hop-cost", "--diffusion-time", "--wall-follow-weight", "--window-length",
+                      "--window-scales", "--landmark-bands", "--max-windows")
+"""map's options whose MapConfig field (``--max-windows``: ``max_windows``) a validation message may name."""
+
+
+def in_option_terms(message: str) -> str:
+    """A MapConfig validation message in map's terms: fields named as their options
+    (MAP_CONFIG_OPTIONS), Python's None as the options' 'none'."""
+    for option in MAP_CONFIG_OPTIONS:
+        message = re.sub(rf"\b{option[2:].replace('-', '_')}\b", option, message)
+    return re.sub(r"\bNone\b", "'none'", message)
+
+
 def _parse_max_windows(text: Optional[str]):
     """A --max-windows value: 'none' (every window) or a whole number >= 1."""
     if text is None or text.strip().lower() == "none":
@@ -458,7 +472,7 @@ def map_command(
                            landmark_bands=landmark_bands or MapConfig.landmark_bands,
                            max_windows=max_windows_option(max_windows), agreement=agreement).validate()
     except SwarmtopoError as exc:  # options that do not go together: a usage error
-        raise typer.BadParameter(str(exc)) from None
+        raise typer.BadParameter(in_option_terms(str(exc))) from None
     model = load_classifier(classifier) if classifier else None  # None: the shipped one for the log
     log = read_log(log_dir)
     if verbose:

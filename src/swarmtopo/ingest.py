@@ -389,6 +389,9 @@ def _existing(path) -> Path:
     path = Path(path)
     if path.is_dir():
         raise InputError("is a folder, not a trace file", file=str(path))
+    if path.exists() and not path.is_file():
+        raise InputError("is not a regular file (a pipe, socket or device: a trace is read more than once, "
+                         "so save it to a file first)", file=str(path))
     if not path.is_file():
         raise InputError("trace file not found", file=str(path))
     return path
@@ -503,6 +506,7 @@ def _parquet_batches(path: Path, names: dict[str, str], rows: _Rows):
                 arr = _seconds(arr)
             elif key != "t" and pa.types.is_floating(arr.type):
                 arr = pc.if_else(pc.is_nan(arr), pa.scalar(None, arr.type), arr)  # NaN: no ID
+                arr = pc.add(arr, pa.scalar(0.0, arr.type))  # -0.0 + 0.0 = 0.0: agent 0, as map reads it
             if key != "t" or not (pa.types.is_integer(arr.type) or pa.types.is_floating(arr.type)):
                 try:
                     arr = pc.cast(arr, pa.string())  # Parquet values are exact: not trimmed

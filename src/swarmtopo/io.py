@@ -62,7 +62,7 @@ import pyarrow.parquet as pq
 
 from .arena import Arena
 from .errors import InputError, SwarmtopoError
-from .log import EncounterLog, parse_states, state_labels
+from .log import EncounterLog, float_ids, parse_states, state_labels
 
 FORMATS: tuple[str, ...] = ("csv", "parquet")
 LOG_FORMAT = "swarmtopo-log/1"
@@ -299,7 +299,7 @@ def _read_ground_truth(directory, name: str, columns, id_columns, position_colum
     declared = _read_meta(directory / "meta.json").get("agent_ids")
     ids = _id_arrays([(table[col], path, col, rows) for col in id_columns], declared=declared)
     out = {"t": _number_column(table["t"], path, "t", "time", rows)}
-    out.update({col: _id_numpy(values) for col, values in zip(id_columns, ids)})
+    out.update({col: _id_numpy(values, path, col, rows) for col, values in zip(id_columns, ids)})
     for col in position_columns:
         out[col] = _number_column(table[col], path, col, "position", rows)
     return path, table, out
@@ -866,10 +866,11 @@ def integer_ids(columns: list[pa.Array]) -> list[pa.Array] | None:
         return None
 
 
-def _id_numpy(ids) -> np.ndarray:
-    """IDs as numpy: int64, or an object array of str."""
+def _id_numpy(ids, path: Path, column: str, rows: np.ndarray) -> np.ndarray:
+    """IDs of ``path``'s ``column`` as numpy: int64 (float IDs checked whole, as the log's
+    are, an error naming the file row ``rows[i]``), or an object array of str."""
     if isinstance(ids, np.ndarray):
-        return ids.astype(np.int64) if ids.dtype.kind == "f" else ids
+        return float_ids(ids, str(path), column, rows) if ids.dtype.kind == "f" else ids
     return ids.to_numpy(zero_copy_only=False).astype(object)
 
 

@@ -350,17 +350,7 @@ def _factorize_ids(values, src, col) -> _IdColumn:
     if len(arr) == 0:
         return _IdColumn.empty(src, col)
     if arr.dtype.kind == "f":
-        bad = ~np.isfinite(arr) | (arr != np.round(arr))
-        if bad.any():
-            i = int(np.argmax(bad))
-            raise InputError("agent ID must be an integer or a text label", file=src, row=i + 1,
-                             column=col, value=arr[i])
-        huge = (arr >= 2.0 ** 63) | (arr < -(2.0 ** 63))
-        if huge.any():  # the cast would wrap them, merging distinct agents
-            i = int(np.argmax(huge))
-            raise InputError("a float agent ID must be a whole number within the int64 range (|ID| < 2^63): "
-                             "write such IDs as integers or text", file=src, row=i + 1, column=col, value=arr[i])
-        arr = arr.astype(np.int64)
+        arr = float_ids(arr, src, col)
     elif arr.dtype.kind in "iub":
         arr = arr.astype(np.int64)
     else:
@@ -370,9 +360,29 @@ def _factorize_ids(values, src, col) -> _IdColumn:
             if missing.any():
                 i = int(np.argmax(missing))
                 raise InputError("agent ID is missing", file=src, row=i + 1, column=col, value=arr[i])
+            nul = np.fromiter((isinstance(v, str) and "\x00" in v for v in arr), dtype=bool, count=len(arr))
+            if nul.any():
+                _refuse_nul(arr[int(np.argmax(nul))], src, int(np.argmax(nul)) + 1, col)
         arr = arr.astype(str)
     labels, index = np.unique(arr, return_inverse=True)
     return _checked_text(_IdColumn(labels, index.reshape(-1).astype(np.int64), src, col))
+
+
+def float_ids(arr: np.ndarray, src, col, rows: np.ndarray | None = None) -> np.ndarray:
+    """Float agent IDs as int64, each a whole number within int64 (else InputError at its
+    row: ``rows[i]``, or i + 1 without ``rows``)."""
+    bad = ~np.isfinite(arr) | (arr != np.round(arr))
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise InputError("agent ID must be an integer or a text label", file=src,
+                         row=int(rows[i]) if rows is not None else i + 1, column=col, value=arr[i])
+    huge = (arr >= 2.0 ** 63) | (arr < -(2.0 ** 63))
+    if huge.any():  # the cast would wrap them, merging distinct agents
+        i = int(np.argmax(huge))
+        raise InputError("a float agent ID must be a whole number within the int64 range (|ID| < 2^63): "
+                         "write such IDs as integers or text", file=src,
+                         row=int(rows[i]) if rows is not None else i + 1, column=col, value=arr[i])
+    return arr.astype(np.int64)
 
 
 def _arrow_ids(arr, src, col):
@@ -393,6 +403,9 @@ def _arrow_ids(arr, src, col):
     except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
         raise InputError(f"agent ID must be an integer or a text label, not {arr.type}", file=src,
                          column=col, value=arr[0].as_py()) from None
+    nul = pc.match_substring(arr, "\x00").to_numpy(zero_copy_only=False)
+    if nul.any():
+        _refuse_nul(arr[int(np.argmax(nul))].as_py(), src, int(np.argmax(nul)) + 1, col)
     enc = pc.dictionary_encode(arr)
     labels = np.asarray(enc.dictionary.to_pylist(), dtype=str).reshape(-1)
     order = np.argsort(labels)
@@ -400,6 +413,13 @@ def _arrow_ids(arr, src, col):
     rank[order] = np.arange(len(order))
     index = rank[enc.indices.to_numpy(zero_copy_only=False).astype(np.int64)]
     return _checked_text(_IdColumn(labels[order], index, src, col))
+
+
+def _refuse_nul(value: str, src, row: int, col) -> None:
+    """InputError for a text ID holding a NUL character: text IDs are held as numpy
+    strings, which drop trailing NULs, so 'a\\x00' would merge with 'a'."""
+    raise InputError("agent ID contains a NUL character (\\x00), which an ID cannot hold: it would merge with "
+                     "the same ID without it", file=src, row=row, column=col, value=value)
 
 
 def _checked_text(ids: _IdColumn) -> _IdColumn:

@@ -67,6 +67,10 @@ def build_wall_grid(segments: np.ndarray, bounds, cell: float, reach: float) -> 
     """
     segs = np.array(segments, dtype=np.float64, order="C").reshape(-1, 4)  # writable: one kernel type
     xmin, ymin, xmax, ymax = (float(v) for v in bounds)
+    # a reach beyond the bounds' diagonal lists every segment in every cell, as the diagonal
+    # does; capping both keeps the exact test's coordinates finite (a reach of 1e300 overflowed)
+    diagonal = max(math.hypot(xmax - xmin, ymax - ymin), WALL_EPS)
+    reach, cell = min(reach, diagonal), min(cell, diagonal)
     ncx = max(1, math.ceil((xmax - xmin) / cell))
     ncy = max(1, math.ceil((ymax - ymin) / cell))
     if ncx * ncy > MAX_WALL_CELLS:
