@@ -15,7 +15,12 @@ reporting maps alone, scored on the grid; the 10-fold cross-validated scores of 
 maps; then per budget of the grid the maps right beside what the /4 and /3 models on
 all maps and the /2 model on the reporting maps expect.
 
+With ``--reading contact-trace`` it reads the same cases mapped as contact traces
+(``benchmarks/trace_accuracy.py --planning``'s store) by the ``trace`` classifier:
+the evidence for ``plan --input contact-trace``'s model.
+
     python benchmarks/plan_forms.py --store full.duckdb
+    python benchmarks/plan_forms.py --store trace.duckdb --reading contact-trace
 """
 
 from __future__ import annotations
@@ -27,8 +32,10 @@ import numpy as np
 
 from swarmtopo.classify import load_classifier
 from swarmtopo.experiments.accuracy import (PIPELINES, PLANNING_BUDGETS, PLANNING_CELLS, PLANNING_PER_CELL,
-                                            REPORTING_PER_CELL, outcomes, planning_jobs, reporting_jobs)
+                                            REPORTING_PER_CELL, TRACE_PIPELINE, outcomes, planning_jobs,
+                                            reporting_jobs)
 from swarmtopo.experiments.store import job_rows_each
+from swarmtopo.experiments.sweep import INPUTS
 from swarmtopo.plan import fit_plan
 
 FOLDS = 10
@@ -57,12 +64,17 @@ def _cross_validated(records, fit, rng) -> tuple[float, float]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--store", required=True, help="store of a full swarmtopo bench accuracy run")
+    parser.add_argument("--store", required=True, help="store of a full swarmtopo bench accuracy run "
+                                                           "(or of trace_accuracy.py --planning)")
+    parser.add_argument("--reading", choices=INPUTS, default="log",
+                        help="the cases mapped as log folders (default) or as contact traces")
     args = parser.parse_args()
 
-    classifier = load_classifier(PIPELINES["default"]["classifier"])
-    reporting = reporting_jobs(REPORTING_PER_CELL, {"default": PIPELINES["default"]})
-    planning = planning_jobs(PLANNING_PER_CELL)
+    trace = args.reading == "contact-trace"
+    classifier = load_classifier("trace" if trace else PIPELINES["default"]["classifier"])
+    reporting = reporting_jobs(REPORTING_PER_CELL, {"contact-trace": TRACE_PIPELINE} if trace
+                               else {"default": PIPELINES["default"]})
+    planning = planning_jobs(PLANNING_PER_CELL, reading=args.reading)
     reporting_rows, planning_rows = job_rows_each(args.store, reporting, planning)
     reported = outcomes(reporting_rows, classifier)
     planned = outcomes(planning_rows, classifier, cells=PLANNING_CELLS)
@@ -84,7 +96,7 @@ def main() -> None:
         print(f"{name}: log loss {loss:.4f}, Brier {brier:.4f} ({FOLDS}-fold cross-validated)")
 
     model, form3 = fit_plan(both, "/4, all"), fit_plan(both, "/3, all", swarm_terms=1)
-    print(f"/4 on all maps (what bench accuracy ships): c0 {model.intercept:.3f}, c1 (ln N/A) {model.density_coef:.3f}, "
+    print(f"/4 on all maps (what {'trace_accuracy.py --plan-out' if trace else 'bench accuracy'} ships): c0 {model.intercept:.3f}, c1 (ln N/A) {model.density_coef:.3f}, "
           f"c2 (ln T) {model.duration_coef:.3f}, c4 (ln N) {model.agents_coef:.3f}, c5 (ln N ln T) "
           f"{model.agents_duration_coef:.3f}, c3 (H) {model.holes_coef:.3f}; {model.maps} maps")
     print("| budget | planning maps right | /4 on all maps expects | /3 on all maps | /2 on reporting maps |")

@@ -16,13 +16,19 @@ per classifier, the beta_1 confidence's reliability there (as ``reclassify.py
 --planning``): the trace classifier's confidence is fitted on the calibration grid read
 the same way, never on these cases.
 
+``--plan-out`` (with ``--planning``) fits ``swarmtopo plan``'s model on the contact
+traces, the reporting and planning-grid maps read by the trace classifier, as the full
+``swarmtopo bench accuracy`` fits it on log folders; the shipped
+``src/swarmtopo/data/plan-trace.json`` is this file (``plan --input contact-trace``).
+
     python benchmarks/trace_accuracy.py --store trace.duckdb [--compare full.duckdb] [--quick] [--planning]
-                                        [--classifier trace default]
+                                        [--classifier trace default] [--plan-out plan-trace.json]
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 
 from reclassify import planning_summary
@@ -32,6 +38,8 @@ from swarmtopo.experiments.accuracy import (CELLS, PIPELINES, PLANNING_CELLS, QU
                                             planning_jobs, rate_text, reliability, reporting_jobs)
 from swarmtopo.experiments.store import job_rows
 from swarmtopo.experiments.sweep import run_sweep
+from swarmtopo.io import write_json
+from swarmtopo.plan import fit_plan
 
 
 def main() -> None:
@@ -46,7 +54,12 @@ def main() -> None:
                              "`map` uses for a log without status changes)")
     parser.add_argument("--planning", action="store_true",
                         help="also map the planning grid as contact traces and print the confidence's reliability there")
+    parser.add_argument("--plan-out", help="with --planning: write the plan model of contact traces, fitted on the "
+                                           "reporting and planning-grid traces read by the trace classifier, here "
+                                           "(the shipped one is src/swarmtopo/data/plan-trace.json)")
     args = parser.parse_args()
+    if args.plan_out and (not args.planning or args.quick):
+        parser.error("--plan-out needs --planning (the grid tells swarm size from duration) and the full suite")
     per_cell = QUICK_PER_CELL if args.quick else REPORTING_PER_CELL
     jobs = reporting_jobs(per_cell, pipelines={"contact-trace": TRACE_PIPELINE})
     grid = planning_jobs(reading="contact-trace") if args.planning else []
@@ -89,6 +102,15 @@ def main() -> None:
         print(f"\nplanning grid read as contact traces ({len(grid_rows)} maps):")
         for name in args.classifier:
             print(planning_summary(name, outcomes(grid_rows, load_classifier(name), cells=PLANNING_CELLS)))
+    if args.plan_out:
+        trace = load_classifier("trace")
+        records = outcomes(rows, trace) + outcomes(job_rows(args.store, grid), trace, cells=PLANNING_CELLS)
+        command = "python benchmarks/trace_accuracy.py " + " ".join(sys.argv[1:])
+        model = fit_plan(records, source=command)
+        write_json(model.to_json(), args.plan_out)
+        print(f"\nwrote {args.plan_out}: the plan of contact traces, fitted on {model.maps} maps: c0 = "
+              f"{model.intercept:.2f}, c1 = {model.density_coef:.2f}, c2 = {model.duration_coef:.2f}, "
+              f"c4 = {model.agents_coef:.2f}, c5 = {model.agents_duration_coef:.2f}, c3 = {model.holes_coef:.2f}")
 
 
 if __name__ == "__main__":

@@ -119,14 +119,14 @@ def test_a_room_cut_before_its_agents_met_is_not_reported_as_several_rooms_with_
     assert any("only a longer log tells one room from several" in line for line in tmap.advice())
     assert tmap.to_json()["beta0_evidence"]["regions"] == tmap.betti[0]
     assert any("swarmtopo plan --area" in line for line in tmap.advice())
-    # the same encounters as a contact trace: plan's table (arenas with status) is not offered
+    # the same encounters as a contact trace: plan's model of contact traces is offered
     trace = map_encounters(contact_trace(log), MapConfig(**FAST))
     assert trace.classifier["classifier"] == "trace" and trace.confidence[0] == tmap.confidence[0]
     assert not any("swarmtopo plan --area" in line for line in trace.advice())
-    assert any("'Contact traces'" in line for line in trace.advice())
+    assert any("swarmtopo plan --input contact-trace --area" in line for line in trace.advice())
     # it is the log that is a trace, whichever classifier reads it
     read_as_paper = map_encounters(contact_trace(log), MapConfig(**FAST), classifier=load_classifier("paper"))
-    assert any("'Contact traces'" in line for line in read_as_paper.advice())
+    assert any("swarmtopo plan --input contact-trace --area" in line for line in read_as_paper.advice())
     # the same room recorded for 20 s: one region, and sure of it
     whole = map_encounters(simulate(square_arena(), 300, 20.0, rng=1).log, MapConfig(**FAST))
     assert whole.betti[0] == 1 and whole.confidence[0] > 0.95

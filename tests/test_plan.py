@@ -173,11 +173,13 @@ def test_plan_cli_forward_and_inverse(tmp_path):
     assert res.exit_code != 0
 
 
-def test_shipped_plan_was_fitted_on_the_full_benchmark():
+@pytest.mark.parametrize("reading", ["log", "contact-trace"])
+def test_shipped_plan_was_fitted_on_the_full_benchmark(reading):
     from swarmtopo.experiments.accuracy import (BUDGETS, CELLS, PLANNING_BUDGETS, PLANNING_CELLS, PLANNING_PER_CELL,
                                                 PLANNING_SCALE_RANGE, REPORTING_PER_CELL, SCALE_RANGE)
-    model = load_plan()
+    model = load_plan(reading=reading)
     assert model.maps == len(CELLS) * REPORTING_PER_CELL + len(PLANNING_CELLS) * PLANNING_PER_CELL
+    assert ("trace_accuracy.py" in model.source) == (reading == "contact-trace")
     # its ranges are the suite's and the planning grid's: 100-800 agents in (500 s)^2 rooms of
     # scale 0.75-2 (two rooms of the suite share their swarm), 15-120 s
     budgets = BUDGETS + PLANNING_BUDGETS
@@ -196,6 +198,25 @@ def test_shipped_plan_was_fitted_on_the_full_benchmark():
     for log_n in np.log(model.agents_range):
         assert model.duration_coef + model.agents_duration_coef * log_n > 0
     assert model.accuracy(1e6, 800, 30, 2) > model.accuracy(0.25e6, 200, 30, 2)
+
+
+def test_plan_cli_answers_for_contact_traces_from_their_own_model(tmp_path):
+    log, trace = load_plan(), load_plan(reading="contact-trace")
+    assert trace != log
+    args = ["plan", "--area", "250000", "--agents", "200", "--duration", "60"]
+    for reading, model in (("log", log), ("contact-trace", trace)):
+        res = runner.invoke(app, args + ["--input", reading])
+        assert res.exit_code == 0, res.output
+        assert f"{100 * model.accuracy(250000, 200, 60):.0f}%" in res.output
+        assert ("as a contact trace" in res.output) == (reading == "contact-trace")
+    res = runner.invoke(app, args + ["--input", "trace"])
+    assert res.exit_code == 2 and "'trace' is not one of 'log', 'contact-trace'" in res.output
+    path = tmp_path / "plan.json"
+    path.write_text(json.dumps(log.to_json()))
+    res = runner.invoke(app, args + ["--input", "contact-trace", "--model", str(path)])
+    assert res.exit_code == 2 and "--model names its own plan" in res.output
+    with pytest.raises(InputError, match="no plan for input 'x'"):
+        load_plan(reading="x")
 
 
 def test_swarms_too_small_to_map_are_refused_and_sizes_outside_the_benchmark_are_extrapolations(tmp_path):

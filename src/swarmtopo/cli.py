@@ -716,8 +716,17 @@ def bench_accuracy(
         out.print(f"wrote {', '.join(str(p) for p in written)}", markup=False, highlight=False, soft_wrap=True)
 
 
+def _plan_input_option(value: str) -> str:
+    from .plan import SHIPPED_PLANS
+
+    if value not in SHIPPED_PLANS:
+        raise typer.BadParameter(f"{value!r} is not one of {', '.join(map(repr, SHIPPED_PLANS))}")
+    return value
+
+
 @app.command(epilog="Examples: swarmtopo plan --area 250000 --agents 200 --duration 30;  "
-                    "swarmtopo plan --area 250000 --agents 200 --target 0.95 --holes 3")
+                    "swarmtopo plan --area 250000 --agents 200 --target 0.95 --holes 3;  "
+                    "swarmtopo plan --input contact-trace --area 250000 --agents 200 --duration 60")
 def plan(
     area: float = typer.Option(..., "--area", callback=_positive_option, help="Area inside the outer walls, mm^2."),
     agents: Optional[int] = typer.Option(None, "--agents", min=1, callback=_agents_option,
@@ -727,14 +736,19 @@ def plan(
                                            help="Wanted exact-match accuracy, e.g. 0.95."),
     holes: Optional[int] = typer.Option(None, "--holes", min=0, help="Holes the arena is expected to have "
                                         "(default: averaged over the benchmark's mix of 0-3 holes)."),
+    reading: str = typer.Option("log", "--input", callback=_plan_input_option,
+                                help="What will be mapped: 'log' (encounters and status changes, as the simulator "
+                                     "writes them) or 'contact-trace' (encounters only, as 'swarmtopo ingest' "
+                                     "writes a proximity trace)."),
     model_file: Optional[Path] = typer.Option(None, "--model", help="plan.json of a benchmark run "
-                                                                    "(default: the shipped one)."),
+                                                                    "(default: the shipped one for --input)."),
 ) -> None:
     """What accuracy a deployment will get, or the agents / time it needs for a target.
 
     Give --agents and --duration for the expected accuracy; or one of them and --target
-    for the other; --holes if you know how many holes to expect.  Answers come from the
-    accuracy benchmark (docs/accuracy.md).
+    for the other; --holes if you know how many holes to expect; --input contact-trace
+    if the swarm will record encounters only.  Answers come from the accuracy benchmark
+    (docs/accuracy.md).
     """
     from .pipeline import MIN_REGION_AGENTS
     from .plan import load_plan
@@ -744,8 +758,12 @@ def plan(
     given = {"agents": agents is not None, "duration": duration is not None, "target": target is not None}
     if sum(given.values()) != 2:
         raise typer.BadParameter("give two of --agents, --duration and --target (the third is computed)")
-    model = load_plan(model_file)
+    if model_file is not None and reading != "log":
+        raise typer.BadParameter("--model names its own plan; drop --input or --model", param_hint="--input")
+    model = load_plan(model_file, reading)
     with_holes = "" if holes is None else f" with {holes} hole{'' if holes == 1 else 's'}"
+    if reading == "contact-trace":
+        with_holes += ", as a contact trace"
     if target is None:
         p = model.accuracy(area, agents, duration, holes)
         out.print(f"expected exact (beta_0, beta_1) accuracy: {100 * p:.0f}% "

@@ -394,7 +394,7 @@ class TopologicalMap:
     software: dict[str, str] = field(default_factory=dict)
     log_warnings: list[str] = field(default_factory=list)  # about the mapped log as a whole
     beta0_evidence: Beta0Evidence | None = None  # what beta_0's confidence was read from
-    contact_trace: bool = False  # the log has no status changes (plan's table does not cover it)
+    contact_trace: bool = False  # the log has no status changes: its advice names plan --input contact-trace
 
     @property
     def warnings(self) -> list[str]:
@@ -428,10 +428,8 @@ class TopologicalMap:
         more_time = ("" if self.windows_left_out else
                      f"record longer (each extra {self.config.window_step or length / 2:.3g} s adds a window to "
                      "the pooling), " if np.isfinite(length) else "record longer, ")
-        how_much = ("'swarmtopo plan --area A --agents N --target 0.95' tells how much"
-                    if not self.contact_trace else
-                    "for a contact trace (no status changes), docs/accuracy.md 'Contact traces' gives the accuracy by "
-                    "swarm size and duration ('swarmtopo plan' answers for logs with status changes)")
+        how_much = ("'swarmtopo plan " + ("--input contact-trace " if self.contact_trace else "")
+                    + "--area A --agents N --target 0.95' tells how much")
         lines.append(f"to raise it: {more_time}use more agents than {self.n_agents} (denser windows); {how_much}")
         return lines
 

@@ -8,7 +8,9 @@ format /4, ln N ln T (time buys more with more agents):
 
 (A in mm^2 inside the outer walls, N agents, T seconds).  The shipped
 ``swarmtopo/data/plan.json`` is the /4 model the full ``swarmtopo bench accuracy`` fits
-on its reporting maps and its planning grid (``experiments.accuracy.PLANNING_CELLS``).
+on its reporting maps and its planning grid (``experiments.accuracy.PLANNING_CELLS``);
+``plan-trace.json`` is the same form fitted on the same cases read as contact traces
+(encounters only, the ``trace`` classifier: ``benchmarks/trace_accuracy.py``).
 The reporting budgets raise N and T together (200 x 30 s, 300 x 40 s, 400 x 60 s), so
 alone they cannot tell what more agents buy from what more time buys; the grid varies
 N, T and A each on its own.  ``--quick`` runs no grid and fits the /2 form (c4 = c5 = 0);
@@ -168,11 +170,21 @@ def fit_plan(records: Sequence[dict[str, Any]], source: str, *, swarm_terms: int
                      (float(agents.min()), float(agents.max())), float(coef[3]), float(coef[4]))
 
 
-def load_plan(path: str | Path | None = None) -> PlanModel:
-    """The shipped plan model (``swarmtopo/data/plan.json``) or one from a file."""
+SHIPPED_PLANS = {"log": "plan.json", "contact-trace": "plan-trace.json"}
+"""The shipped plan model of each reading: log folders (``swarmtopo bench accuracy``'s
+full run) and contact traces, the same cases read as encounters only
+(``benchmarks/trace_accuracy.py --planning --plan-out``)."""
+
+
+def load_plan(path: str | Path | None = None, reading: str = "log") -> PlanModel:
+    """The shipped plan model of ``reading`` (SHIPPED_PLANS) or one from a file."""
     if path is None:
-        text = resources.files("swarmtopo.data").joinpath("plan.json").read_text("utf-8")
-        return PlanModel.from_json(json.loads(text), source="swarmtopo/data/plan.json")
+        if reading not in SHIPPED_PLANS:
+            raise InputError(f"no plan for input {reading!r}; expected one of {', '.join(SHIPPED_PLANS)}",
+                             column="input", value=reading)
+        name = SHIPPED_PLANS[reading]
+        text = resources.files("swarmtopo.data").joinpath(name).read_text("utf-8")
+        return PlanModel.from_json(json.loads(text), source=f"swarmtopo/data/{name}")
     from .io import read_json
 
     return PlanModel.from_json(read_json(path), source=str(path))
