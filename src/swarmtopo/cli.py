@@ -761,24 +761,24 @@ def plan(
     if model_file is not None and reading != "log":
         raise typer.BadParameter("--model names its own plan; drop --input or --model", param_hint="--input")
     model = load_plan(model_file, reading)
-    with_holes = "" if holes is None else f" with {holes} hole{'' if holes == 1 else 's'}"
+    qualifier = "" if holes is None else f" with {holes} hole{'' if holes == 1 else 's'}"
     if reading == "contact-trace":
-        with_holes += ", as a contact trace"
+        qualifier += ", as a contact trace"
     if target is None:
         p = model.accuracy(area, agents, duration, holes)
         out.print(f"expected exact (beta_0, beta_1) accuracy: {100 * p:.0f}% "
-                  f"({agents} agents x {duration:g} s in {area:g} mm^2{with_holes})", markup=False, highlight=False)
+                  f"({agents} agents x {duration:g} s in {area:g} mm^2{qualifier})", markup=False, highlight=False)
         n, t = agents, duration
     elif agents is None:
         n = max(model.agents_for(area, duration, target, holes), MIN_REGION_AGENTS)  # fewer cannot be mapped
         t = duration
-        out.print(_plan_answer("agents", n, f"for {100 * target:.10g}% in {duration:g} s over {area:g} mm^2{with_holes}"),
+        out.print(_plan_answer("agents", n, f"for {100 * target:.10g}% in {duration:g} s over {area:g} mm^2{qualifier}"),
                   markup=False, highlight=False)
     else:
         t = model.duration_for(area, agents, target, holes)
         n = agents
         out.print(_plan_answer("seconds of data", t,
-                               f"for {100 * target:.10g}% with {agents} agents over {area:g} mm^2{with_holes}"),
+                               f"for {100 * target:.10g}% with {agents} agents over {area:g} mm^2{qualifier}"),
                   markup=False, highlight=False)
     if np.isfinite(n) and np.isfinite(t) and not model.inside(area, n, t, holes):
         lo, hi = model.density_range
