@@ -331,6 +331,9 @@ def test_parquet_nulls_and_nan_ids_are_missing_values_and_text_is_kept_exactly(t
 
 def test_parquet_float_ids_minus_zero_is_agent_zero_as_map_reads_it(tmp_path):
     path = tmp_path / "trace.parquet"
+    half = pa.table({"t": [1.0, 2.0], "a": pa.array([0.0, -0.0], pa.float16()), "b": pa.array([1.0, 2.0], pa.float16())})
+    pq.write_table(half, path)
+    assert events(ingest(path, "parquet")[0]) == [(1.0, "0", "1"), (2.0, "0", "2")]  # float16 IDs too
     pq.write_table(pa.table({"t": [1.0, 2.0, 3.0], "a": [0.0, 1.0, -0.0], "b": [1.0, 2.0, 2.0]}), path)
     log, _ = ingest(path, "parquet")
     assert events(log) == [(1.0, "0", "1"), (2.0, "1", "2"), (3.0, "0", "2")] and log.agent_ids.dtype.kind == "i"
@@ -345,6 +348,8 @@ def test_ids_holding_a_nul_and_traces_that_are_not_regular_files_are_refused(tmp
     with pytest.raises(InputError, match="NUL") as caught:
         ingest(path, "parquet")
     assert (caught.value.row, caught.value.column, caught.value.value) == (3, "a", "x\x00")
+    log, report = ingest(path, "parquet", skip_bad=True)  # a malformed line like any other
+    assert events(log) == [(1.0, "x", "y"), (2.0, "y", "z")] and report.skipped == 1
     fifo = tmp_path / "pipe"
     os.mkfifo(fifo)  # as /dev/stdin is when a trace is piped in: never opened, so never blocks
     with pytest.raises(InputError, match="not a regular file.*save it to a file first"):

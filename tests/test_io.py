@@ -425,7 +425,7 @@ def test_truth_and_trajectories_round_trip(tmp_path, fmt, ids):
     assert read_arena(tmp_path / "arena.geojson") == default_arena()
 
 
-def test_truth_float_ids_are_checked_as_the_logs_are(tmp_path):
+def test_truth_ids_are_checked_as_the_logs_are(tmp_path):
     write_log(make_log(), tmp_path)
     columns = {"t": [0.0, 1.0], "xa": [0.0] * 2, "ya": [0.0] * 2, "xb": [0.0] * 2, "yb": [0.0] * 2}
     for a, reason in (([1.0, 3.5], "must be an integer"), ([1.0, 1e20], "int64 range")):
@@ -435,6 +435,9 @@ def test_truth_float_ids_are_checked_as_the_logs_are(tmp_path):
         assert reason in str(err)
     pq.write_table(pa.table({**columns, "a": [1.0, -0.0], "b": [2.0, 4.0]}), tmp_path / "truth.parquet")
     assert read_truth(tmp_path)["a"].tolist() == [1, 0]
+    pq.write_table(pa.table({**columns, "a": ["x1", "x2"], "b": ["x3", "x4\x00"]}), tmp_path / "truth.parquet")
+    err = read_error_of(read_truth, tmp_path)  # a text ID holding a NUL, as in the log
+    assert (err.row, err.column, err.value) == (2, "b", "x4\x00") and "NUL" in str(err)
 
 
 def read_error_of(read, path) -> InputError:

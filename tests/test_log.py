@@ -159,6 +159,10 @@ def test_text_ids_holding_a_nul_are_refused_not_merged():
         assert "NUL" in err.reason
     err = error_of([0.0], ["a"], pa.array(["b\x00c"]))  # inside an ID too
     assert (err.row, err.column) == (1, "b")
+    err = error_of([0.0, 1.0, 2.0], ["a", "b", "a\x00"], ["b", "c", "c"])  # a Python list, not numpy strings first
+    assert (err.row, err.column, err.value) == (3, "a", "a\x00")
+    err = error_of([0.0], np.array(["a\x00b"]), ["c"])  # numpy strings keep a NUL inside an ID
+    assert (err.row, err.column) == (1, "a")
 
 
 def test_float_ids_beyond_int64_are_refused_not_wrapped():

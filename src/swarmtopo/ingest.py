@@ -32,7 +32,8 @@ Formats
 Malformed lines
 ---------------
 A line is malformed if it has the wrong number of fields, a time that is not a
-finite number >= 0 (>= w for SocioPatterns), an empty ID, ``a == b``, a ONE state
+finite number >= 0 (>= w for SocioPatterns), an empty ID, an ID holding a NUL
+character (it would merge with the ID without it), ``a == b``, a ONE state
 other than up / down, or text that is not UTF-8 (a CSV file that is not UTF-8 is
 refused whole: pyarrow cannot hand such a row back to be skipped).  Without
 ``skip_bad`` the first one raises an :class:`~.errors.InputError` naming the file, the
@@ -59,7 +60,7 @@ import pyarrow.parquet as pq
 from .errors import InputError, SwarmtopoError
 from .io import (GZIP_MAGIC, SNIFF_BYTES, coarse_time, integer_ids, non_utf8_problem, refuse_binary,
                  refuse_merged_by_trimming)
-from .log import MAX_TIME, TOO_LATE, EncounterLog
+from .log import MAX_TIME, NUL_ID, TOO_LATE, EncounterLog
 
 FORMATS: tuple[str, ...] = ("csv", "parquet", "sociopatterns", "one")
 SOCIOPATTERNS_WINDOW = 20.0
@@ -505,6 +506,8 @@ def _parquet_batches(path: Path, names: dict[str, str], rows: _Rows):
                     pa.types.is_duration(arr.type) or pa.types.is_time(arr.type)) else "")
                 arr = _seconds(arr)
             elif key != "t" and pa.types.is_floating(arr.type):
+                if pa.types.is_float16(arr.type):  # exact in float32, which arrow computes on
+                    arr = pc.cast(arr, pa.float32())
                 arr = pc.if_else(pc.is_nan(arr), pa.scalar(None, arr.type), arr)  # NaN: no ID
                 arr = pc.add(arr, pa.scalar(0.0, arr.type))  # -0.0 + 0.0 = 0.0: agent 0, as map reads it
             if key != "t" or not (pa.types.is_integer(arr.type) or pa.types.is_floating(arr.type)):
@@ -691,6 +694,8 @@ def _ids_ok(a: pa.Array, b: pa.Array, line, names: tuple[str, str], rows: _Rows,
     for col, name in zip((a, b), names):
         empty = pc.fill_null(pc.equal(pc.utf8_length(col), 0), True).to_numpy(zero_copy_only=False)
         ok &= rows.reject(ok & empty, line, name, col, "agent ID is missing")
+        nul = pc.fill_null(pc.match_substring(col, "\x00"), False).to_numpy(zero_copy_only=False)
+        ok &= rows.reject(ok & nul, line, name, col, NUL_ID)
     same = pc.fill_null(pc.equal(a, b), False).to_numpy(zero_copy_only=False)
     ok &= rows.reject(ok & same, line, names[1], b, "an agent cannot encounter itself")
     return ok

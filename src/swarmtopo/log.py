@@ -346,7 +346,10 @@ def _factorize_ids(values, src, col) -> _IdColumn:
         values = _arrow_ids(values, src, col)
         if isinstance(values, _IdColumn):
             return values
-    arr = np.asarray(values)
+    if isinstance(values, (list, tuple)) and any(isinstance(v, str) for v in values):
+        arr = np.asarray(values, dtype=object)  # as numpy strings, trailing NULs would already be gone
+    else:
+        arr = np.asarray(values)
     if len(arr) == 0:
         return _IdColumn.empty(src, col)
     if arr.dtype.kind == "f":
@@ -361,8 +364,10 @@ def _factorize_ids(values, src, col) -> _IdColumn:
                 i = int(np.argmax(missing))
                 raise InputError("agent ID is missing", file=src, row=i + 1, column=col, value=arr[i])
             nul = np.fromiter((isinstance(v, str) and "\x00" in v for v in arr), dtype=bool, count=len(arr))
-            if nul.any():
-                _refuse_nul(arr[int(np.argmax(nul))], src, int(np.argmax(nul)) + 1, col)
+        else:  # numpy strings: a NUL inside an ID (trailing ones are gone already)
+            nul = np.strings.find(arr.astype(str), "\x00") >= 0
+        if nul.any():
+            refuse_nul(arr[int(np.argmax(nul))], src, int(np.argmax(nul)) + 1, col)
         arr = arr.astype(str)
     labels, index = np.unique(arr, return_inverse=True)
     return _checked_text(_IdColumn(labels, index.reshape(-1).astype(np.int64), src, col))
@@ -405,7 +410,7 @@ def _arrow_ids(arr, src, col):
                          column=col, value=arr[0].as_py()) from None
     nul = pc.match_substring(arr, "\x00").to_numpy(zero_copy_only=False)
     if nul.any():
-        _refuse_nul(arr[int(np.argmax(nul))].as_py(), src, int(np.argmax(nul)) + 1, col)
+        refuse_nul(arr[int(np.argmax(nul))].as_py(), src, int(np.argmax(nul)) + 1, col)
     enc = pc.dictionary_encode(arr)
     labels = np.asarray(enc.dictionary.to_pylist(), dtype=str).reshape(-1)
     order = np.argsort(labels)
@@ -415,11 +420,15 @@ def _arrow_ids(arr, src, col):
     return _checked_text(_IdColumn(labels[order], index, src, col))
 
 
-def _refuse_nul(value: str, src, row: int, col) -> None:
-    """InputError for a text ID holding a NUL character: text IDs are held as numpy
-    strings, which drop trailing NULs, so 'a\\x00' would merge with 'a'."""
-    raise InputError("agent ID contains a NUL character (\\x00), which an ID cannot hold: it would merge with "
-                     "the same ID without it", file=src, row=row, column=col, value=value)
+NUL_ID = ("agent ID contains a NUL character (\\x00), which an ID cannot hold: it would merge with the same ID "
+          "without it")
+"""Why a text ID holding a NUL is refused: text IDs are held as numpy strings, which drop
+trailing NULs, so 'a\\x00' would merge with 'a'."""
+
+
+def refuse_nul(value: str, src, row: int, col) -> None:
+    """InputError (NUL_ID) for the text ID ``value`` at ``row`` of ``src``'s column ``col``."""
+    raise InputError(NUL_ID, file=src, row=row, column=col, value=value)
 
 
 def _checked_text(ids: _IdColumn) -> _IdColumn:
