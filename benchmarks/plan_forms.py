@@ -96,7 +96,8 @@ def main() -> None:
         print(f"{name}: log loss {loss:.4f}, Brier {brier:.4f} ({FOLDS}-fold cross-validated)")
 
     model, form3 = fit_plan(both, "/4, all"), fit_plan(both, "/3, all", swarm_terms=1)
-    print(f"/4 on all maps (what {'trace_accuracy.py --plan-out' if trace else 'bench accuracy'} ships): c0 {model.intercept:.3f}, c1 (ln N/A) {model.density_coef:.3f}, "
+    shipper = "trace_accuracy.py --plan-out" if trace else "bench accuracy"
+    print(f"/4 on all maps (what {shipper} ships): c0 {model.intercept:.3f}, c1 (ln N/A) {model.density_coef:.3f}, "
           f"c2 (ln T) {model.duration_coef:.3f}, c4 (ln N) {model.agents_coef:.3f}, c5 (ln N ln T) "
           f"{model.agents_duration_coef:.3f}, c3 (H) {model.holes_coef:.3f}; {model.maps} maps")
     print("| budget | planning maps right | /4 on all maps expects | /3 on all maps | /2 on reporting maps |")

@@ -97,14 +97,15 @@ def main() -> None:
             trace_right = {(r["cell"], r["index"]) for r in records if r["right"]}
             print(f"{name}: right only as a contact trace {len(trace_right - full_right)}, "
                   f"only with the full log folder {len(full_right - trace_right)}")
+    grid_rows = job_rows(args.store, grid) if grid else []
     if grid:
-        grid_rows = job_rows(args.store, grid)
         print(f"\nplanning grid read as contact traces ({len(grid_rows)} maps):")
         for name in args.classifier:
             print(planning_summary(name, outcomes(grid_rows, load_classifier(name), cells=PLANNING_CELLS)))
-    if args.plan_out:
+    if args.plan_out:  # the rows read above, the reporting outcomes too when the trace classifier was asked for
         trace = load_classifier("trace")
-        records = outcomes(rows, trace) + outcomes(job_rows(args.store, grid), trace, cells=PLANNING_CELLS)
+        reported = columns.get("contact trace, trace classifier") or outcomes(rows, trace)
+        records = reported + outcomes(grid_rows, trace, cells=PLANNING_CELLS)
         command = "python benchmarks/trace_accuracy.py " + " ".join(sys.argv[1:])
         model = fit_plan(records, source=command)
         write_json(model.to_json(), args.plan_out)

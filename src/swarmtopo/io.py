@@ -62,7 +62,7 @@ import pyarrow.parquet as pq
 
 from .arena import Arena
 from .errors import InputError, SwarmtopoError
-from .log import EncounterLog, float_ids, parse_states, refuse_nul, state_labels
+from .log import EncounterLog, float_ids, parse_states, refuse_nul_ids, state_labels
 
 FORMATS: tuple[str, ...] = ("csv", "parquet")
 LOG_FORMAT = "swarmtopo-log/1"
@@ -872,10 +872,7 @@ def _id_numpy(ids, path: Path, column: str, rows: np.ndarray) -> np.ndarray:
     name the file row ``rows[i]``."""
     if isinstance(ids, np.ndarray):
         return float_ids(ids, str(path), column, rows) if ids.dtype.kind == "f" else ids
-    nul = pc.match_substring(ids, "\x00").to_numpy(zero_copy_only=False)
-    if nul.any():
-        i = int(np.argmax(nul))
-        refuse_nul(ids[i].as_py(), str(path), int(rows[i]), column)
+    refuse_nul_ids(ids, str(path), column, rows)
     return ids.to_numpy(zero_copy_only=False).astype(object)
 
 

@@ -367,7 +367,8 @@ def _factorize_ids(values, src, col) -> _IdColumn:
         else:  # numpy strings: a NUL inside an ID (trailing ones are gone already)
             nul = np.strings.find(arr.astype(str), "\x00") >= 0
         if nul.any():
-            refuse_nul(arr[int(np.argmax(nul))], src, int(np.argmax(nul)) + 1, col)
+            i = int(np.argmax(nul))
+            raise InputError(NUL_ID, file=src, row=i + 1, column=col, value=arr[i])
         arr = arr.astype(str)
     labels, index = np.unique(arr, return_inverse=True)
     return _checked_text(_IdColumn(labels, index.reshape(-1).astype(np.int64), src, col))
@@ -376,17 +377,17 @@ def _factorize_ids(values, src, col) -> _IdColumn:
 def float_ids(arr: np.ndarray, src, col, rows: np.ndarray | None = None) -> np.ndarray:
     """Float agent IDs as int64, each a whole number within int64 (else InputError at its
     row: ``rows[i]``, or i + 1 without ``rows``)."""
+    rows = np.arange(1, len(arr) + 1) if rows is None else rows
     bad = ~np.isfinite(arr) | (arr != np.round(arr))
     if bad.any():
         i = int(np.argmax(bad))
-        raise InputError("agent ID must be an integer or a text label", file=src,
-                         row=int(rows[i]) if rows is not None else i + 1, column=col, value=arr[i])
+        raise InputError("agent ID must be an integer or a text label", file=src, row=int(rows[i]), column=col,
+                         value=arr[i])
     huge = (arr >= 2.0 ** 63) | (arr < -(2.0 ** 63))
     if huge.any():  # the cast would wrap them, merging distinct agents
         i = int(np.argmax(huge))
         raise InputError("a float agent ID must be a whole number within the int64 range (|ID| < 2^63): "
-                         "write such IDs as integers or text", file=src,
-                         row=int(rows[i]) if rows is not None else i + 1, column=col, value=arr[i])
+                         "write such IDs as integers or text", file=src, row=int(rows[i]), column=col, value=arr[i])
     return arr.astype(np.int64)
 
 
@@ -408,9 +409,7 @@ def _arrow_ids(arr, src, col):
     except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
         raise InputError(f"agent ID must be an integer or a text label, not {arr.type}", file=src,
                          column=col, value=arr[0].as_py()) from None
-    nul = pc.match_substring(arr, "\x00").to_numpy(zero_copy_only=False)
-    if nul.any():
-        refuse_nul(arr[int(np.argmax(nul))].as_py(), src, int(np.argmax(nul)) + 1, col)
+    refuse_nul_ids(arr, src, col)
     enc = pc.dictionary_encode(arr)
     labels = np.asarray(enc.dictionary.to_pylist(), dtype=str).reshape(-1)
     order = np.argsort(labels)
@@ -426,9 +425,14 @@ NUL_ID = ("agent ID contains a NUL character (\\x00), which an ID cannot hold: i
 trailing NULs, so 'a\\x00' would merge with 'a'."""
 
 
-def refuse_nul(value: str, src, row: int, col) -> None:
-    """InputError (NUL_ID) for the text ID ``value`` at ``row`` of ``src``'s column ``col``."""
-    raise InputError(NUL_ID, file=src, row=row, column=col, value=value)
+def refuse_nul_ids(ids: pa.Array, src, col, rows: np.ndarray | None = None) -> None:
+    """InputError (NUL_ID) at the first of the text ``ids`` (no nulls) holding a NUL: at
+    row ``rows[i]`` of ``src``'s column ``col``, or i + 1 without ``rows``."""
+    nul = pc.match_substring(ids, "\x00").to_numpy(zero_copy_only=False)
+    if nul.any():
+        i = int(np.argmax(nul))
+        raise InputError(NUL_ID, file=src, row=int(rows[i]) if rows is not None else i + 1, column=col,
+                         value=ids[i].as_py())
 
 
 def _checked_text(ids: _IdColumn) -> _IdColumn:
