@@ -32,10 +32,17 @@ options are the defaults of ``MapConfig``; the script stops with an error if the
 (both when none is named) on the tuning cases and the calibration grid, stops unless
 they give the shipped thresholds, and rewrites those classifiers' confidence alone.
 
+``--regions-only [default] [trace]`` maps only the tuning cases of the cells whose arenas
+have several regions (two rooms) and refits only the named classifiers'
+``regions_exponent`` (:func:`~swarmtopo.ratio.map_confidence`), reading those maps with
+the shipped thresholds and regional model: what the full and ``--calibrate-only`` runs
+fit last.  Either way the script prints the several-region maps' Brier score and log
+loss under the plain product, the power a cross-fitted over 10 folds, and a constant.
+
 Usage::
 
     python scripts/tune_accuracy.py [--store tuning.duckdb] [--per-cell 20] [--workers N] [--scheduler ADDR]
-                                    [--calibrate-only [default] [trace]]
+                                    [--calibrate-only [default] [trace] | --regions-only [default] [trace]]
 """
 
 from __future__ import annotations
@@ -53,9 +60,10 @@ from swarmtopo.experiments.accuracy import (CELLS, HELD_OUT_FAMILY, PLANNING_CEL
 from swarmtopo.experiments.store import job_rows
 from swarmtopo.experiments.sweep import job_map_config, map_input, run_sweep
 from swarmtopo.experiments.tuning import (PIPELINE_FIELDS, Q_GRID, TAU_GRID, calibrated_classifier, cross_validated, exact,
-                                         fit_thresholds, maps_from_rows)
+                                         fit_regions_exponent, fit_thresholds, maps_from_rows, regions_exponent_scores,
+                                         several_region_products, with_regions_exponent)
 from swarmtopo.pipeline import MapConfig
-from swarmtopo.ratio import POOLINGS, confidence_readout
+from swarmtopo.ratio import POOLINGS, REGIONS_EXPONENT, confidence_readout
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -108,7 +116,15 @@ def main() -> None:
                         help="map only these classifiers' candidates (default and trace when none is named) on the "
                              "tuning cases and the calibration grid, check that they give the shipped thresholds "
                              "and rewrite the classifiers' confidence (docs/tuning.md is left as it is)")
+    parser.add_argument("--regions-only", nargs="*", choices=tuple(SHIPPED), metavar="CLASSIFIER",
+                        help="map only the several-region tuning cells for these classifiers (default and trace when "
+                             "none is named) and refit only their regions_exponent")
     args = parser.parse_args()
+    if args.regions_only is not None:
+        if args.calibrate_only is not None:
+            parser.error("--regions-only and --calibrate-only exclude each other")
+        _refit_regions_exponent(args)
+        return
 
     started = time.perf_counter()
     calibrate_only = args.calibrate_only is not None
@@ -171,6 +187,7 @@ def main() -> None:
         model.save(ROOT / "src" / "swarmtopo" / "data" / f"classifier-{name}.json")
         print(f"classifier-{name}.json: confidence {model.calibration_['1']} "
               f"({len(grid_maps[name])} calibration-grid maps); {confidence_readout(model)}")
+        _print_regions_scores(name, chosen["maps"], model)
     if calibrate_only:
         print(f"wrote the confidence of {', '.join(f'classifier-{n}.json' for n in shipping)} "
               f"({(time.perf_counter() - started) / 60:.1f} min)")
@@ -183,6 +200,45 @@ def main() -> None:
                transfer=(default_thresholds, int(transfer.sum()), trace["total"]))
     print(f"chosen: {CHOSEN[0]}, {CHOSEN[1]} pooling; for contact traces: {CHOSEN_TRACE[0]}, {CHOSEN_TRACE[1]} "
           "pooling; wrote classifier-default.json, classifier-trace.json and docs/tuning.md")
+
+
+def _refit_regions_exponent(args) -> None:
+    """``--regions-only``: map the several-region tuning cells and refit the named shipped
+    classifiers' regions_exponent alone."""
+    started = time.perf_counter()
+    shipping = tuple(dict.fromkeys(args.regions_only or SHIPPED))
+    several = [c for c in CELLS if c.generator == "two_rooms"]
+    with tuning_session():
+        jobs = {n: tuning_jobs({SHIPPED[n][0]: {"metric": "hybrid", "classifier": "paper-form",
+                                                **CANDIDATES[SHIPPED[n][0]]}}, per_cell=args.per_cell, cells=several)
+                for n in shipping}
+        every = [j for js in jobs.values() for j in js]
+        summary = run_sweep(every, args.store, scheduler=args.scheduler, workers=args.workers,
+                            progress=lambda done, total, failed: print(f"\r{done}/{total} jobs", end="", flush=True))
+        print(f"\n{summary}")
+        stored = {row["key"]: row for row in job_rows(args.store, every)}
+        for name in shipping:
+            maps = maps_from_rows([stored[j.key] for j in sorted(jobs[name], key=lambda j: j.key) if j.key in stored],
+                                  cell_of)
+            model = load_classifier(name)
+            log_products, right = several_region_products(maps, model)
+            with_regions_exponent(model, fit_regions_exponent(log_products, right), len(right))
+            model.save(ROOT / "src" / "swarmtopo" / "data" / f"classifier-{name}.json")
+            _print_regions_scores(name, maps, model)
+    print(f"wrote the regions_exponent of {', '.join(f'classifier-{n}.json' for n in shipping)} "
+          f"({(time.perf_counter() - started) / 60:.1f} min)")
+
+
+def _print_regions_scores(name: str, maps, model) -> None:
+    """The several-region maps' confidence scores (:func:`regions_exponent_scores`), as docs/accuracy.md quotes them."""
+    log_products, right = several_region_products(maps, model)
+    if len(np.unique(right)) < 2:
+        print(f"classifier-{name}.json: {len(right)} several-region maps, not both right and wrong: no regions_exponent")
+        return
+    scores = regions_exponent_scores(log_products, right)
+    print(f"classifier-{name}.json: regions_exponent {model.calibration_['1'][REGIONS_EXPONENT]:.4f} on "
+          f"{len(right)} several-region maps ({int(right.sum())} right); "
+          + "; ".join(f"{k}: Brier {v['brier']:.4f}, log loss {v['log_loss']:.4f}" for k, v in scores.items()))
 
 
 def _rate(flags) -> tuple[int, int]:

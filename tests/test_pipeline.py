@@ -52,6 +52,9 @@ def test_two_disjoint_rooms_give_two_regions():
     # one infinite H0 bar per region in the union diagram
     assert np.isinf(tmap.diagram[0][:, 1]).sum() == 2
     assert sum(r.n_events for r in tmap.regions) + sum(s["events"] for s in tmap.too_little_data) == sim.log.n_events
+    # beta_1's confidence: the regions' product to the default classifier's fitted power
+    a = load_classifier("default").calibration_["1"]["regions_exponent"]
+    assert tmap.confidence[1] == pytest.approx(np.prod([r.confidence[1] for r in tmap.regions]) ** a)
 
 
 @pytest.mark.slow

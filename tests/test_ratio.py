@@ -11,9 +11,10 @@ from swarmtopo.persistence import Diagram
 from scipy.special import expit
 
 from swarmtopo.pipeline import MapConfig, fitted_landmark_bands
-from swarmtopo.ratio import (LOG_RATIO_CAP, MAX_MARGIN, RESOLUTION_CAP, SCORE_VAR_PRIOR, Z_CAP, RatioClassifier,
-                             RatioThresholds, SPAN_FEATURES, below_full_resolution, calibrated_probability, confidence_readout,
-                             longest_bars, median_vote, pooled_scores, region_reader, resolution, windows_span,
+from swarmtopo.ratio import (LOG_RATIO_CAP, MAX_MARGIN, REGIONS_EXPONENT, RESOLUTION_CAP, SCORE_VAR_PRIOR, Z_CAP,
+                             RatioClassifier, RatioThresholds, SPAN_FEATURES, below_full_resolution, calibrated_probability,
+                             confidence_readout, longest_bars, map_confidence, median_vote, pooled_scores, region_reader,
+                             resolution, windows_span,
                              score_matrix, score_margin, standardised_margin, vote, window_scores)
 
 TH = RatioThresholds(q=0.5, tau=2.0)
@@ -188,6 +189,35 @@ def test_the_span_features_are_ln_t_and_z_ln_t_and_a_calibration_never_reads_a_m
         calibrated_probability(model.calibration_["1"], {"z": plain["z"]})
     with pytest.raises(InputError, match="unknown confidence feature.*log_span"):  # no file weighs the span
         RatioClassifier({1: TH}, calibration={"1": {"intercept": 0.0, "z": 1.0, "log_span": 0.1}})
+
+
+def test_a_map_of_several_regions_raises_the_product_of_their_confidences_to_the_fitted_power():
+    calibration = {"intercept": -3.0, "z": 1.2, "maps": 10}
+    plain = RatioClassifier({1: TH}, calibration={"1": calibration})
+    powered = RatioClassifier({1: TH}, calibration={"1": {**calibration, REGIONS_EXPONENT: 0.5}})
+    assert map_confidence(plain, [0.9, 0.8]) == pytest.approx(0.72)  # no exponent: the plain product
+    assert map_confidence(powered, [0.9, 0.8]) == pytest.approx(0.72 ** 0.5)
+    assert map_confidence(powered, [0.9, 0.8, 0.5]) == pytest.approx(0.36 ** 0.5)
+    assert map_confidence(powered, [0.9]) == 0.9  # one region: its own confidence, never powered
+    assert map_confidence(powered, [0.9, None]) is None and map_confidence(powered, []) is None
+    assert map_confidence(powered, [0.9, 0.8], n=2) == pytest.approx(0.72)  # fitted for beta_1 only
+    assert map_confidence(object(), [0.9, 0.8]) == pytest.approx(0.72)  # a classifier without calibration
+    # the exponent is not a feature: the regional confidence is the same with or without it
+    windows = [with_landmarks(20)] * 3
+    assert powered.region_confidence(windows)[1] == plain.region_confidence(windows)[1]
+    assert "to the power 0.5" in powered.describe()["confidence"]
+    for bad in (0.0, -1.0):
+        with pytest.raises(InputError, match="must be positive") as caught:
+            RatioClassifier({1: TH}, calibration={"1": {**calibration, REGIONS_EXPONENT: bad}})
+        assert caught.value.column == f"calibration.1.{REGIONS_EXPONENT}"
+
+
+def test_the_shipped_classifiers_power_raises_a_several_region_confidence():
+    # fitted on the two-room tuning maps, where the plain product was below how often they were right
+    for name in ("default", "trace"):
+        a = load_classifier(name).calibration_["1"][REGIONS_EXPONENT]
+        assert 0 < a < 1
+        assert map_confidence(load_classifier(name), [0.9, 0.9]) > 0.81
 
 
 def test_windows_span_is_the_first_start_to_the_last_end():

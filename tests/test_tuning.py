@@ -8,9 +8,10 @@ import pytest
 
 from swarmtopo.experiments.tuning import (A_GRID, B_GRID, Q_GRID, TAU_GRID, TuningMap, calibrated_classifier,
                                          cross_fitted_features, cross_validated, exact, features_under, fit_gate,
-                                         fit_thresholds, maps_from_rows, fit_veto, gate_estimates, grid_estimates)
+                                         fit_regions_exponent, fit_thresholds, maps_from_rows, fit_veto, gate_estimates,
+                                         grid_estimates, regions_exponent_scores, several_region_products)
 from swarmtopo.persistence import Diagram
-from swarmtopo.ratio import CONFIDENCE_FEATURES, RatioClassifier, RatioThresholds
+from swarmtopo.ratio import CONFIDENCE_FEATURES, REGIONS_EXPONENT, RatioClassifier, RatioThresholds, map_confidence
 
 
 def window(holes, rng):
@@ -88,6 +89,60 @@ def test_calibration_grid_maps_join_the_cross_fitted_ones_read_with_the_final_th
     # 36 of 37 outcomes right, and the wrong one has the features of many right ones: below 36/37 at most
     assert model.region_confidence(grid[0].regions[0])[1] < calibrated_classifier(
         maps, th, provenance={}, folds=3).region_confidence(grid[0].regions[0])[1]
+
+
+def test_the_regions_exponent_is_the_maximum_likelihood_power_and_recovers_a_known_one():
+    rng = np.random.default_rng(7)
+    s = np.log(rng.uniform(0.2, 1.0, 4000))  # ln of two-region products
+    right = rng.random(4000) < np.exp(0.5 * s)  # P(right) = product ** 0.5
+    a = fit_regions_exponent(s, right)
+    assert abs(a - 0.5) < 0.05
+    # the score equation of the likelihood is zero at its maximum: sum_right s = sum_wrong s p / (1 - p)
+    p = np.exp(a * s)
+    assert np.sum(s[right]) == pytest.approx(np.sum((s * p / (1 - p))[~right]), rel=1e-3)
+    with pytest.raises(ValueError, match="both right and wrong"):
+        fit_regions_exponent(s[right], right[right])
+
+
+def test_regions_exponent_scores_hand_computed_constant_and_product():
+    s, right = np.log(np.array([0.9, 0.5, 0.8, 0.3] * 5)), np.array([True, False, True, True] * 5)
+    scores = regions_exponent_scores(s, right, folds=5)
+    assert scores["constant"]["brier"] == pytest.approx(0.75 * 0.25)  # rate 3/4: mean of (3/4 - y)^2
+    assert scores["product"]["brier"] == pytest.approx(np.mean((np.exp(s) - right) ** 2))
+    assert 0 < scores["product to the power a (cross-fitted)"]["brier"] < 1
+
+
+def two_region_maps(n, rng):
+    """Maps of two rooms with 0-1 holes each; every third claims one hole more than it has."""
+    maps = []
+    for i in range(n):
+        holes = [int(rng.integers(0, 2)) for _ in range(2)]
+        regions = tuple(tuple(window(h, rng) for _ in range(3)) for h in holes)
+        maps.append(TuningMap(regions=regions, est_betti0=2, true_betti0=2, true_betti1=sum(holes) + (i % 3 == 0),
+                              cell="two rooms"))
+    return maps
+
+
+def test_several_region_products_are_the_literal_regions_product_and_join_the_calibration():
+    rng = np.random.default_rng(11)
+    maps = synthetic_maps(30, rng)
+    rooms = two_region_maps(12, rng)
+    th = fit_thresholds(maps).thresholds
+    model = calibrated_classifier(maps + rooms, th, provenance={"name": "t"}, folds=3)
+    log_products, right = several_region_products(maps + rooms, model)
+    assert len(right) == 12 and right.tolist() == [i % 3 != 0 for i in range(12)]
+    for m, s in zip(rooms, log_products):
+        literal = np.prod([model.region_confidence(region)[1] for region in m.regions])
+        assert np.exp(s) == pytest.approx(literal)
+    a = model.calibration_["1"][REGIONS_EXPONENT]
+    assert a == pytest.approx(fit_regions_exponent(log_products, right))
+    assert model.provenance_["regions_calibration"] == "fitted on 12 several-region tuning maps"
+    confidences = [model.region_confidence(region)[1] for region in rooms[0].regions]
+    assert map_confidence(model, confidences) == pytest.approx(np.prod(confidences) ** a)
+    # without several-region maps, or with all of them right, no exponent: the plain product
+    assert REGIONS_EXPONENT not in calibrated_classifier(maps, th, provenance={}, folds=3).calibration_["1"]
+    all_right = [m for m, ok in zip(rooms, right) if ok]
+    assert REGIONS_EXPONENT not in calibrated_classifier(maps + all_right, th, provenance={}, folds=3).calibration_["1"]
 
 
 def test_cross_validated_count_reads_every_map_once_with_out_of_fold_thresholds():

@@ -39,8 +39,8 @@ from .landmarks import (MIN_LANDMARKS, SUBSAMPLERS, Landmarks, knn_distances, kn
 from .log import EncounterLog, exact_time
 from .persistence import Diagram, PersistenceResult, rips_persistence
 from .agreement import overlapping, rank_agreement, window_coordinates
-from .ratio import (RESOLUTION_CAP, RatioClassifier, below_full_resolution, longest_bars, region_reader, resolution,
-                    vote)
+from .ratio import (RESOLUTION_CAP, RatioClassifier, below_full_resolution, longest_bars, map_confidence, region_reader,
+                    resolution, vote)
 
 
 MIN_REGION_AGENTS = 3
@@ -372,8 +372,9 @@ class TopologicalMap:
     holes (None for a dimension the classifier has no Theta_n for).
     ``confidence[n]`` is the probability that ``betti[n]`` is right: beta_0's from
     :mod:`swarmtopo.beta0` (read from ``beta0_evidence``); beta_n for n >= 1 is a sum
-    over regions, so its confidence is the product of the regions' (see
-    :mod:`swarmtopo.ratio`; None without a calibrated classifier).
+    over regions, so its confidence is one region's, or for several the product of the
+    regions' raised to a calibrated power (:func:`~swarmtopo.ratio.map_confidence`; None
+    without a calibrated classifier).
     ``diagram`` is the union of the regions' diagrams.
     """
 
@@ -712,8 +713,7 @@ def map_encounters(
     for n in range(1, config.maxdim + 1):
         known = all(n in r.betti for r in regions)
         betti[n] = sum(r.betti[n] for r in regions) if known else None
-        region_conf = [r.confidence.get(n) for r in regions]
-        confidence[n] = (float(np.prod(region_conf)) if known and None not in region_conf else None)
+        confidence[n] = map_confidence(classifier, [r.confidence.get(n) for r in regions], n) if known else None
     too_little = [{"component": int(c), "events": int(events_per_comp[c]), "agents": int(agents_per_comp[c])}
                   for c in np.setdiff1d(np.arange(len(events_per_comp)), regions_idx)]
     return TopologicalMap(

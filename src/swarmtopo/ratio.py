@@ -59,6 +59,14 @@ alone are applied so.  Files calibrated before z existed carry coefficients of t
 windows' *agreement* with the vote, the vote's log *margin* (capped at MAX_MARGIN) and
 the log number of *windows*; they are applied as they were fitted (:data:`REGION_FEATURES`).
 
+A map of several regions (beta_0 >= 2) is right when every region is, and its
+confidence is the product of its regions' raised to a power a, ``regions_exponent`` of
+the calibration (:func:`map_confidence`; 1, the plain product, where a file has none).
+The regional model is fitted on one-region maps, whose landmarks cover a whole arena; a
+region of a two-room arena has fewer (ln L lower) and its confidence is lower than how
+often it is right.  a is fitted by maximum likelihood on the benchmark's two-room tuning
+maps (``scripts/tune_accuracy.py``; docs/accuracy.md, "Confidence").
+
 Earlier files (/1, /2) could also gate bars by death/birth ratio, length in covering
 radii and a largest-gap rule; measured over three tuning rounds they never raised the
 rate and the shipped classifiers had them off.  Such files are read when the gates are
@@ -107,6 +115,10 @@ OLD_FEATURES = ("agreement", "margin", "windows")
 REGION_FEATURES = (*CONFIDENCE_FEATURES, *OLD_FEATURES)
 """Every feature :meth:`RatioClassifier.region_features` gives: a calibration weighs z, the
 resolution and their product, z alone, or (files calibrated before z) the other three."""
+REGIONS_EXPONENT = "regions_exponent"
+"""The calibration key of a, the power of the product of a several-region map's regional
+confidences (:func:`map_confidence`)."""
+
 LOG_RATIO_CAP = float(np.log(1e3))
 """Cap of a bar's score: a bar 1000 times the typical noise loop (or infinite) is as long as it gets."""
 
@@ -183,11 +195,24 @@ def calibrated_probability(model: dict[str, float], features: dict[str, float]) 
     """P(right) of a fitted calibration ``model`` (intercept, maps and one coefficient per
     feature it weighs) at ``features``: expit(intercept + sum of coefficient x feature).
     A feature it weighs that ``features`` lacks is an error, not a zero."""
-    weighed = {name: coef for name, coef in model.items() if name not in ("intercept", "maps")}
+    weighed = {name: coef for name, coef in model.items() if name not in ("intercept", "maps", REGIONS_EXPONENT)}
     missing = sorted(set(weighed) - set(features))
     if missing:
         raise ValueError(f"the confidence calibration weighs {', '.join(missing)}, which the region's features lack")
     return float(expit(model["intercept"] + sum(coef * features[name] for name, coef in weighed.items())))
+
+
+def map_confidence(classifier, confidences: Sequence[float | None], n: int = 1) -> float | None:
+    """P(a map's beta_n is right) from its regions' P(right) ``confidences``: the one
+    region's, or for several the product raised to the calibration's ``regions_exponent``
+    a (1 where ``classifier`` has none); None if a region has none."""
+    if not len(confidences) or any(p is None for p in confidences):
+        return None
+    product = float(np.prod(confidences))
+    if len(confidences) == 1:
+        return product
+    model = getattr(classifier, "calibration_", {}).get(str(n)) or {}
+    return product ** float(model.get(REGIONS_EXPONENT, 1.0))
 
 
 def confidence_model() -> LogisticRegression:
@@ -346,7 +371,8 @@ class RatioClassifier:
                 raise InputError("an agreement gate needs dimension 1, mean pooling and 0 <= agreement < 1",
                                  column=f"thresholds.{n}.agreement", value=th.agreement)
         for n, model in (calibration or {}).items():
-            unknown = set(model) - {"intercept", "maps", *REGION_FEATURES} if isinstance(model, dict) else ()
+            unknown = (set(model) - {"intercept", "maps", REGIONS_EXPONENT, *REGION_FEATURES}
+                       if isinstance(model, dict) else ())
             if unknown:
                 raise InputError(f"unknown confidence feature(s) {sorted(unknown)}; known: "
                                  f"{', '.join(REGION_FEATURES)}", column=f"calibration.{n}", value=model)
@@ -361,6 +387,8 @@ class RatioClassifier:
                 if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or (
                         key == "maps" and value < 0):
                     raise InputError("must be a finite number", column=f"calibration.{n}.{key}", value=value)
+                if key == REGIONS_EXPONENT and value <= 0:
+                    raise InputError("must be positive", column=f"calibration.{n}.{key}", value=value)
         self.thresholds_ = {int(n): th for n, th in sorted(thresholds.items())}
         self.calibration_ = dict(calibration or {})
         self.provenance_ = dict(provenance or {})
@@ -524,6 +552,13 @@ class RatioClassifier:
         model = self.calibration_.get("1")
         if model is None:
             return "uncalibrated"
+        return self._region_confidence_definition(model) + (
+            f"; a map of several regions: the product of its regions' to the power {model[REGIONS_EXPONENT]:.3g}, "
+            "fitted on the benchmark's two-room tuning maps" if REGIONS_EXPONENT in model else
+            "; a map of several regions: the product of its regions'")
+
+    @staticmethod
+    def _region_confidence_definition(model: dict[str, float]) -> str:
         if "resolution" in model:
             return ("P(correct) from a logistic model of z, how many standard errors (over the windows) the pooled "
                     "scores are from changing the vote, of the windows' resolution ln L (L landmarks, at most "

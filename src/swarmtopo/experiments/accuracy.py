@@ -38,7 +38,7 @@ from ..arena import HOLE_SHAPES, OUTER_SHAPES
 from ..cycles import wilson_interval
 from ..errors import SwarmtopoError
 from ..persistence import Diagram
-from ..ratio import region_reader, vote
+from ..ratio import map_confidence, region_reader, vote
 from ..pipeline import MapConfig
 from .grid import Job, canonical_json, case_streams
 from .sweep import build_arena
@@ -301,7 +301,7 @@ def outcomes(rows, classifier, cells=CELLS) -> list[dict[str, Any]]:
             est1 = sum(voted[0].get(1, 0) for voted in votes)
             confs = [reader.region_confidence(windows, voted).get(1)
                      for reader, windows, voted in zip(readers, regions, votes)]
-            conf1 = None if None in confs else float(np.prod(confs))
+            conf1 = map_confidence(classifier, confs, 1)
             conf0 = row["confidence_betti0"]
         right = row["error"] is None and est0 == row["true_betti0"] and est1 == row["true_betti1"]
         records.append({

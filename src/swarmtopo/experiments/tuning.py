@@ -25,12 +25,14 @@ from typing import Any, Sequence
 
 import numpy as np
 from scipy.ndimage import uniform_filter, uniform_filter1d
+from scipy.optimize import minimize_scalar
+from sklearn.metrics import brier_score_loss, log_loss
 
 from ..persistence import Diagram
 from ..agreement import BARS, agreement_array
 from ..pipeline import MapConfig, resolve_landmark_bands
-from ..ratio import (CONFIDENCE_FEATURES, RatioClassifier, RatioThresholds, pooled_scores, region_reader, window_scores,
-                     windows_span)
+from ..ratio import (CONFIDENCE_FEATURES, REGIONS_EXPONENT, RatioClassifier, RatioThresholds, pooled_scores,
+                     region_reader, window_scores, windows_span)
 from .sweep import cached_classifier, job_classifier, job_map_config
 
 Q_GRID = (0.5, 0.6, 0.7, 0.8, 0.9)
@@ -39,6 +41,8 @@ TAU_GRID = tuple(np.round(np.geomspace(1.2, 12.0, 80), 4))
 A_GRID = tuple(np.round(np.arange(1.60, 2.2001, 0.02), 2))
 B_GRID = tuple(np.round(np.arange(0.0, 0.9601, 0.02), 2))
 """The agreement gate's grid: score threshold a = ln tau_1 and agreement threshold b."""
+REGIONS_EXPONENT_RANGE = (0.05, 20.0)
+"""Where :func:`fit_regions_exponent` searches the power a of a several-region map's product."""
 PIPELINE_FIELDS = ("metric", "hop_cost", "diffusion_time", "wall_follow_weight", "window_length",
                    "window_encounters", "window_scales", "window_step", "landmark_bands")
 """The MapConfig fields the candidate pipelines of ``scripts/tune_accuracy.py`` set: the
@@ -297,4 +301,62 @@ def calibrated_classifier(maps: Sequence[TuningMap], thresholds: RatioThresholds
     if not more_features:
         names, calibration = ("z",), f"{folds}-fold cross-fitted"
     model = RatioClassifier({1: thresholds}, provenance={**provenance, "calibration": calibration}, pooling=pooling)
-    return model.calibrate(features + more_features, correct + more_correct, names)
+    model.calibrate(features + more_features, correct + more_correct, names)
+    log_products, right = several_region_products(maps, model)
+    if len(np.unique(right)) == 2:
+        with_regions_exponent(model, fit_regions_exponent(log_products, right), len(right))
+    return model
+
+
+def several_region_products(maps: Sequence[TuningMap], model: RatioClassifier) -> tuple[np.ndarray, np.ndarray]:
+    """For the ``maps`` of two regions or more: ln of the product of their regions' beta_1
+    confidences under ``model`` (its ``regions_exponent`` ignored) and whether their
+    beta_1 (the sum of the regions') is right."""
+    several = [m for m in maps if len(m.regions) >= 2]
+    log_products, right = [], []
+    for m in several:
+        readers = [_reader(model, m, r) for r in range(len(m.regions))]
+        log_products.append(sum(np.log(reader.region_confidence(region)[1])
+                                for reader, region in zip(readers, m.regions)))
+        right.append(sum(reader.pooled_betti(region)[1] for reader, region in zip(readers, m.regions))
+                     == m.true_betti1)
+    return np.array(log_products, dtype=float), np.array(right, dtype=bool)
+
+
+def fit_regions_exponent(log_products: np.ndarray, right: np.ndarray) -> float:
+    """The maximum-likelihood a of P(right) = exp(a ln prod_r p_r) (:func:`~swarmtopo.ratio.map_confidence`),
+    on maps with both outcomes; searched in REGIONS_EXPONENT_RANGE."""
+    s, y = np.asarray(log_products, dtype=float), np.asarray(right, dtype=bool)
+    if len(np.unique(y)) < 2:
+        raise ValueError("the regions' exponent needs maps both right and wrong")
+
+    def negative_log_likelihood(a: float) -> float:
+        p = np.clip(np.exp(a * s), 1e-12, 1 - 1e-12)
+        return -float(np.sum(np.where(y, np.log(p), np.log1p(-p))))
+
+    return float(minimize_scalar(negative_log_likelihood, bounds=REGIONS_EXPONENT_RANGE, method="bounded",
+                                 options={"xatol": 1e-6}).x)
+
+
+def with_regions_exponent(model: RatioClassifier, a: float, maps: int) -> RatioClassifier:
+    """``model`` with its beta_1 calibration's ``regions_exponent`` set to ``a``, fitted on
+    ``maps`` several-region maps (which its provenance records)."""
+    model.calibration_["1"] = {**model.calibration_["1"], REGIONS_EXPONENT: float(a)}
+    model.provenance_["regions_calibration"] = f"fitted on {maps} several-region tuning maps"
+    return model
+
+
+def regions_exponent_scores(log_products: np.ndarray, right: np.ndarray, folds: int = 10,
+                            seed: int = 0) -> dict[str, dict[str, float]]:
+    """Brier score and log loss of three beta_1 confidences of several-region maps: the
+    plain product, the product to a power fitted without the map (``folds`` shuffled
+    folds, :func:`fit_regions_exponent`), and a constant equal to the maps' rate."""
+    s, y = np.asarray(log_products, dtype=float), np.asarray(right, dtype=bool)
+    fold = np.random.default_rng(seed).permutation(len(y)) % folds
+    held_out = np.empty(len(y))
+    for k in range(folds):
+        held_out[fold == k] = np.exp(fit_regions_exponent(s[fold != k], y[fold != k]) * s[fold == k])
+    scored = {"product": np.exp(s), "product to the power a (cross-fitted)": held_out,
+              "constant": np.full(len(y), y.mean())}
+    return {name: {"brier": float(brier_score_loss(y, p)), "log_loss": float(log_loss(y, p, labels=[False, True]))}
+            for name, p in scored.items()}
