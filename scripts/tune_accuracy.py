@@ -237,7 +237,8 @@ def _print_regions_scores(name: str, maps, model) -> None:
         return
     scores = regions_exponent_scores(log_products, right)
     print(f"classifier-{name}.json: regions_exponent {model.calibration_['1'][REGIONS_EXPONENT]:.4f} on "
-          f"{len(right)} several-region maps ({int(right.sum())} right); "
+          f"{len(right)} several-region maps ({int(right.sum())} right; the plain product says "
+          f"{np.exp(log_products).mean():.3f} on average); "
           + "; ".join(f"{k}: Brier {v['brier']:.4f}, log loss {v['log_loss']:.4f}" for k, v in scores.items()))
 
 
