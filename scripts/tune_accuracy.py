@@ -222,6 +222,9 @@ def _refit_regions_exponent(args) -> None:
                                   cell_of)
             model = load_classifier(name)
             log_products, right = several_region_products(maps, model)
+            if len(np.unique(right)) < 2:
+                raise SystemExit(f"{len(right)} several-region tuning maps for {name}, {int(right.sum())} of them "
+                                 "right: fitting regions_exponent needs maps both right and wrong")
             with_regions_exponent(model, fit_regions_exponent(log_products, right), len(right))
             model.save(ROOT / "src" / "swarmtopo" / "data" / f"classifier-{name}.json")
             _print_regions_scores(name, maps, model)
