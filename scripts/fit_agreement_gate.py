@@ -13,7 +13,10 @@ On those maps, with q_1 the default classifier's, it fits (a = ln tau_1, b) on a
 (``experiments.tuning.fit_gate``: the best 3 x 3 neighbourhood mean), prints the
 exact count per cell against the default's score-only rule (its tau_1, kept in the
 file's provenance as ``score_only``) and the 4-fold cross-validated count, fits the
-confidence model on the same maps cross-fitted (gate refitted without each fold), and
+confidence model on the same maps cross-fitted (gate refitted without each fold) and,
+where its maps hold two-room arenas both right and wrong, the power of a several-region
+map's product (``experiments.tuning.calibrated_classifier``; the shipped file predates it
+and has none, so it reads such maps by the plain product), and
 writes ``src/swarmtopo/data/classifier-gated.json`` (the ``gated`` preset).  Measured,
 it is not better than the default on the suite, which reads the score alone (docs/accuracy.md).
 

@@ -238,7 +238,11 @@ def _print_regions_scores(name: str, maps, model) -> None:
     if len(np.unique(right)) < 2:
         print(f"classifier-{name}.json: {len(right)} several-region maps, not both right and wrong: no regions_exponent")
         return
-    scores = regions_exponent_scores(log_products, right)
+    try:
+        scores = regions_exponent_scores(log_products, right)
+    except ValueError as exc:
+        print(f"classifier-{name}.json: {exc}")
+        return
     print(f"classifier-{name}.json: regions_exponent {model.calibration_['1'][REGIONS_EXPONENT]:.4f} on "
           f"{len(right)} several-region maps ({int(right.sum())} right; the plain product says "
           f"{np.exp(log_products).mean():.3f} on average); "

@@ -133,6 +133,34 @@ def test_table_and_reliability_hand_computed():
     assert lo <= 0.1875 - 0.01 <= hi
 
 
+def test_outcomes_read_a_two_region_map_by_the_classifiers_power_of_the_product():
+    from swarmtopo.persistence import Diagram
+    from swarmtopo.ratio import map_confidence, vote
+
+    def region(long_bar):  # three windows, ten noise loops each, and one long loop or none
+        rng = np.random.default_rng(int(long_bar))
+        windows = []
+        for _ in range(3):
+            h1 = [[b, b + rng.uniform(0.5, 1.5)] for b in rng.uniform(1, 2, 10)] + ([[1.0, 11.0]] if long_bar else [])
+            windows.append(Diagram(pairs=(np.array([[0.0, np.inf]]), np.array(h1)), backend="test"))
+        return windows
+
+    regions = [region(True), region(False)]
+    row = {"config": {"arena": {"generator": "two_rooms", "holes": 1, "shapes": ["square"], "scale": 1.0},
+                      "swarm": {"agents": 300, "duration": 40.0}},
+           "est_betti0": 2, "true_betti0": 2, "true_betti1": 1, "error": None, "confidence_betti0": 0.99,
+           "replicate": 0, "t_total": 1.0,
+           "diagrams": [{"windows": [{"diagram": d.to_json()} for d in windows]} for windows in regions]}
+    classifier = load_classifier("default")
+    [record] = acc.outcomes([row], classifier)
+    confidences = [classifier.region_confidence(windows, vote(classifier, windows))[1] for windows in regions]
+    a = classifier.calibration_["1"]["regions_exponent"]
+    assert record["est_betti1"] == 1 and record["right"]
+    assert record["confidence_betti1"] == pytest.approx(np.prod(confidences) ** a)
+    assert record["confidence_betti1"] == pytest.approx(map_confidence(classifier, confidences))
+    assert record["confidence_betti1"] > np.prod(confidences)  # 0 < a < 1
+
+
 def test_brier_gain_interval_separates_a_sharp_confidence_from_the_constant():
     y = np.r_[np.ones(190), np.zeros(10)]
     # a confidence that knows which maps are wrong beats the constant in every resample

@@ -206,6 +206,13 @@ def test_a_map_of_several_regions_raises_the_product_of_their_confidences_to_the
     windows = [with_landmarks(20)] * 3
     assert powered.region_confidence(windows)[1] == plain.region_confidence(windows)[1]
     assert "to the power 0.5" in powered.describe()["confidence"]
+    restored = RatioClassifier.from_json(powered.to_json())
+    assert restored.calibration_ == powered.calibration_ and map_confidence(restored, [0.9, 0.8]) == pytest.approx(
+        0.72 ** 0.5)
+    # a refit of the regional model drops the power, and the provenance that it was fitted
+    powered.provenance_["regions_calibration"] = "fitted on 96 several-region tuning maps"
+    powered.calibrate([{"z": 1.0}, {"z": 2.0}, {"z": 0.5}], [True, False, True], names=("z",))
+    assert REGIONS_EXPONENT not in powered.calibration_["1"] and "regions_calibration" not in powered.provenance_
     for bad in (0.0, -1.0):
         with pytest.raises(InputError, match="must be positive") as caught:
             RatioClassifier({1: TH}, calibration={"1": {**calibration, REGIONS_EXPONENT: bad}})

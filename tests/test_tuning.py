@@ -110,6 +110,10 @@ def test_regions_exponent_scores_hand_computed_constant_and_product():
     assert scores["constant"]["brier"] == pytest.approx(0.75 * 0.25)  # rate 3/4: mean of (3/4 - y)^2
     assert scores["product"]["brier"] == pytest.approx(np.mean((np.exp(s) - right) ** 2))
     assert 0 < scores["product to the power a (cross-fitted)"]["brier"] < 1
+    # one wrong map cannot be cross-fitted: the fold that holds it trains on right maps only
+    one_wrong = np.array([True] * 19 + [False])
+    with pytest.raises(ValueError, match="too few maps right or wrong"):
+        regions_exponent_scores(s, one_wrong, folds=5)
 
 
 def two_region_maps(n, rng):
@@ -139,6 +143,9 @@ def test_several_region_products_are_the_literal_regions_product_and_join_the_ca
     assert model.provenance_["regions_calibration"] == "fitted on 12 several-region tuning maps"
     confidences = [model.region_confidence(region)[1] for region in rooms[0].regions]
     assert map_confidence(model, confidences) == pytest.approx(np.prod(confidences) ** a)
+    # a one-room arena that a sparse log split in two is not a map of rooms: left out of the fit
+    split = dataclasses.replace(rooms[0], true_betti0=1, true_betti1=rooms[0].true_betti1)
+    assert len(several_region_products([split] + rooms, model)[1]) == 12
     # without several-region maps, or with all of them right, no exponent: the plain product
     assert REGIONS_EXPONENT not in calibrated_classifier(maps, th, provenance={}, folds=3).calibration_["1"]
     all_right = [m for m, ok in zip(rooms, right) if ok]

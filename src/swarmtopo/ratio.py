@@ -205,13 +205,14 @@ def calibrated_probability(model: dict[str, float], features: dict[str, float]) 
 def map_confidence(classifier, confidences: Sequence[float | None], n: int = 1) -> float | None:
     """P(a map's beta_n is right) from its regions' P(right) ``confidences``: the one
     region's, or for several the product raised to the calibration's ``regions_exponent``
-    a (1 where ``classifier`` has none); None if a region has none."""
+    a (1 where a :class:`RatioClassifier` has none, and for classifiers of other kinds);
+    None if a region has none."""
     if not len(confidences) or any(p is None for p in confidences):
         return None
     product = float(np.prod(confidences))
-    if len(confidences) == 1:
+    if len(confidences) == 1 or not isinstance(classifier, RatioClassifier):
         return product
-    model = getattr(classifier, "calibration_", {}).get(str(n)) or {}
+    model = classifier.calibration_.get(str(n)) or {}
     return product ** float(model.get(REGIONS_EXPONENT, 1.0))
 
 
@@ -340,7 +341,8 @@ class RatioClassifier:
     calibration
         Per dimension the logistic P(correct): ``{"intercept", "z", "resolution",
         "z_x_resolution"}``, ``{"intercept", "z"}`` or (older files) ``{"intercept",
-        "agreement", "margin", "windows"}`` (:meth:`region_features`); None = uncalibrated.
+        "agreement", "margin", "windows"}`` (:meth:`region_features`), any of them with
+        ``"regions_exponent"`` (:func:`map_confidence`); None = uncalibrated.
         (beta_0's confidence is the pipeline's: :mod:`swarmtopo.beta0`.)
     provenance
         Free-form record of how it was fitted (name, data, script).
@@ -375,7 +377,8 @@ class RatioClassifier:
                        if isinstance(model, dict) else ())
             if unknown:
                 raise InputError(f"unknown confidence feature(s) {sorted(unknown)}; known: "
-                                 f"{', '.join(REGION_FEATURES)}", column=f"calibration.{n}", value=model)
+                                 f"{', '.join(REGION_FEATURES)} (and {REGIONS_EXPONENT})", column=f"calibration.{n}",
+                                 value=model)
             if isinstance(model, dict) and ("resolution" in model) != ("z_x_resolution" in model):
                 raise InputError("a calibration weighs 'resolution' and 'z_x_resolution' together, or neither",
                                  column=f"calibration.{n}", value=model)
@@ -526,6 +529,7 @@ class RatioClassifier:
             intercept, coefficients = float(np.log(rate / (1 - rate))), np.zeros(len(names))
         self.calibration_ = {"1": {"intercept": intercept, **dict(zip(names, map(float, coefficients))),
                                    "maps": int(len(y))}}
+        self.provenance_.pop("regions_calibration", None)  # a new regional model: no power fitted on it yet
         return self
 
     # -- description and files ------------------------------------------------------------

@@ -8,7 +8,9 @@ only which bars count, so no job is rerun -- for each way of pooling the windows
 a cross-validated count beside the fitted one (:func:`cross_validated`).  The
 confidence model of the chosen candidate is then fitted on the same tuning maps,
 cross-fitted (:func:`calibrated_classifier`, :func:`cross_fitted_features`), and on
-the calibration grid's maps read the same way (:func:`features_under`).
+the calibration grid's maps read the same way (:func:`features_under`), and last the
+power of a several-region map's product of regional confidences on the tuning maps of
+several rooms (:func:`several_region_products`, :func:`fit_regions_exponent`).
 
 ``scripts/fit_agreement_gate.py`` fits the ``gated`` preset from the default's q_1: the
 agreement gate (:func:`fit_gate`: the score threshold a = ln tau_1 and the agreement
@@ -302,6 +304,8 @@ def calibrated_classifier(maps: Sequence[TuningMap], thresholds: RatioThresholds
         names, calibration = ("z",), f"{folds}-fold cross-fitted"
     model = RatioClassifier({1: thresholds}, provenance={**provenance, "calibration": calibration}, pooling=pooling)
     model.calibrate(features + more_features, correct + more_correct, names)
+    # last, the power of a several-region map's product, on the arenas of several rooms
+    # read with the final thresholds (chosen on all the tuning maps, these among them)
     log_products, right = several_region_products(maps, model)
     if len(np.unique(right)) == 2:
         with_regions_exponent(model, fit_regions_exponent(log_products, right), len(right))
@@ -309,10 +313,12 @@ def calibrated_classifier(maps: Sequence[TuningMap], thresholds: RatioThresholds
 
 
 def several_region_products(maps: Sequence[TuningMap], model: RatioClassifier) -> tuple[np.ndarray, np.ndarray]:
-    """For the ``maps`` of two regions or more: ln of the product of their regions' beta_1
-    confidences under ``model`` (its ``regions_exponent`` ignored) and whether their
-    beta_1 (the sum of the regions') is right."""
-    several = [m for m in maps if len(m.regions) >= 2]
+    """For the ``maps`` of arenas of several rooms mapped to two regions or more: ln of the
+    product of their regions' beta_1 confidences under ``model`` (its ``regions_exponent``
+    ignored) and whether their beta_1 (the sum of the regions') is right.  A one-room
+    arena split by a sparse log is left out: its beta_0 is wrong, and the power corrects
+    how rooms read, which is what ``--regions-only`` maps."""
+    several = [m for m in maps if m.true_betti0 >= 2 and len(m.regions) >= 2]
     log_products, right = [], []
     for m in several:
         readers = [_reader(model, m, r) for r in range(len(m.regions))]
@@ -353,6 +359,9 @@ def regions_exponent_scores(log_products: np.ndarray, right: np.ndarray, folds: 
     folds, :func:`fit_regions_exponent`), and a constant equal to the maps' rate."""
     s, y = np.asarray(log_products, dtype=float), np.asarray(right, dtype=bool)
     fold = np.random.default_rng(seed).permutation(len(y)) % folds
+    if any(len(np.unique(y[fold != k])) < 2 for k in range(folds)):
+        raise ValueError(f"too few maps right or wrong ({int(y.sum())} of {len(y)} right) to cross-fit "
+                         f"the regions' exponent over {folds} folds")
     held_out = np.empty(len(y))
     for k in range(folds):
         held_out[fold == k] = np.exp(fit_regions_exponent(s[fold != k], y[fold != k]) * s[fold == k])
