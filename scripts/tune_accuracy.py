@@ -129,10 +129,9 @@ def main() -> None:
     started = time.perf_counter()
     calibrate_only = args.calibrate_only is not None
     shipping = tuple(dict.fromkeys(args.calibrate_only or SHIPPED))  # the classifier files written
-    candidates = {SHIPPED[n][0]: CANDIDATES[SHIPPED[n][0]] for n in shipping} if calibrate_only else CANDIDATES
+    candidates = [SHIPPED[n][0] for n in shipping] if calibrate_only else list(CANDIDATES)
     with tuning_session():
-        pipelines = {name: {"metric": "hybrid", "classifier": "paper-form", **options}
-                     for name, options in candidates.items()}
+        pipelines = {name: _candidate_pipeline(name) for name in candidates}
         jobs = {name: tuning_jobs({name: p}, per_cell=args.per_cell) for name, p in pipelines.items()}
         # each classifier's grid is read as its candidate reads the tuning cases (log folder or contact trace)
         grids = {n: calibration_jobs(reading=map_input(CANDIDATES[SHIPPED[n][0]])) for n in shipping}
@@ -187,7 +186,7 @@ def main() -> None:
         model.save(ROOT / "src" / "swarmtopo" / "data" / f"classifier-{name}.json")
         print(f"classifier-{name}.json: confidence {model.calibration_['1']} "
               f"({len(grid_maps[name])} calibration-grid maps); {confidence_readout(model)}")
-        _print_regions_scores(name, chosen["maps"], model)
+        _print_regions_scores(name, *several_region_products(chosen["maps"], model), model)
     if calibrate_only:
         print(f"wrote the confidence of {', '.join(f'classifier-{n}.json' for n in shipping)} "
               f"({(time.perf_counter() - started) / 60:.1f} min)")
@@ -209,8 +208,8 @@ def _refit_regions_exponent(args) -> None:
     shipping = tuple(dict.fromkeys(args.regions_only or SHIPPED))
     several = [c for c in CELLS if c.generator == "two_rooms"]
     with tuning_session():
-        jobs = {n: tuning_jobs({SHIPPED[n][0]: {"metric": "hybrid", "classifier": "paper-form",
-                                                **CANDIDATES[SHIPPED[n][0]]}}, per_cell=args.per_cell, cells=several)
+        jobs = {n: tuning_jobs({SHIPPED[n][0]: _candidate_pipeline(SHIPPED[n][0])}, per_cell=args.per_cell,
+                               cells=several)
                 for n in shipping}
         every = [j for js in jobs.values() for j in js]
         summary = run_sweep(every, args.store, scheduler=args.scheduler, workers=args.workers,
@@ -222,22 +221,26 @@ def _refit_regions_exponent(args) -> None:
                                   cell_of)
             model = load_classifier(name)
             log_products, right = several_region_products(maps, model)
-            if len(np.unique(right)) < 2:
+            try:
+                a = fit_regions_exponent(log_products, right)
+            except ValueError as exc:
                 raise SystemExit(f"{len(right)} several-region tuning maps for {name}, {int(right.sum())} of them "
-                                 "right: fitting regions_exponent needs maps both right and wrong")
-            with_regions_exponent(model, fit_regions_exponent(log_products, right), len(right))
+                                 f"right: {exc}") from None
+            with_regions_exponent(model, a, len(right))
             model.save(ROOT / "src" / "swarmtopo" / "data" / f"classifier-{name}.json")
-            _print_regions_scores(name, maps, model)
+            _print_regions_scores(name, log_products, right, model)
     print(f"wrote the regions_exponent of {', '.join(f'classifier-{n}.json' for n in shipping)} "
           f"({(time.perf_counter() - started) / 60:.1f} min)")
 
 
-def _print_regions_scores(name: str, maps, model) -> None:
-    """The several-region maps' confidence scores (:func:`regions_exponent_scores`), as docs/accuracy.md quotes them."""
-    log_products, right = several_region_products(maps, model)
-    if len(np.unique(right)) < 2:
-        print(f"classifier-{name}.json: {len(right)} several-region maps, not both right and wrong: no regions_exponent")
-        return
+def _candidate_pipeline(name: str) -> dict:
+    """The job pipeline of candidate ``name`` (CANDIDATES): hybrid metric, paper-form stored readings."""
+    return {"metric": "hybrid", "classifier": "paper-form", **CANDIDATES[name]}
+
+
+def _print_regions_scores(name: str, log_products, right, model) -> None:
+    """The several-region maps' confidence scores (:func:`regions_exponent_scores` of
+    :func:`several_region_products`' output), as docs/accuracy.md quotes them."""
     try:
         scores = regions_exponent_scores(log_products, right)
     except ValueError as exc:

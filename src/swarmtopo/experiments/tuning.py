@@ -34,7 +34,7 @@ from ..persistence import Diagram
 from ..agreement import BARS, agreement_array
 from ..pipeline import MapConfig, resolve_landmark_bands
 from ..ratio import (CONFIDENCE_FEATURES, REGIONS_EXPONENT, RatioClassifier, RatioThresholds, pooled_scores,
-                     region_reader, window_scores, windows_span)
+                     region_reader, vote, window_scores, windows_span)
 from .sweep import cached_classifier, job_classifier, job_map_config
 
 Q_GRID = (0.5, 0.6, 0.7, 0.8, 0.9)
@@ -322,10 +322,10 @@ def several_region_products(maps: Sequence[TuningMap], model: RatioClassifier) -
     log_products, right = [], []
     for m in several:
         readers = [_reader(model, m, r) for r in range(len(m.regions))]
-        log_products.append(sum(np.log(reader.region_confidence(region)[1])
-                                for reader, region in zip(readers, m.regions)))
-        right.append(sum(reader.pooled_betti(region)[1] for reader, region in zip(readers, m.regions))
-                     == m.true_betti1)
+        votes = [vote(reader, region) for reader, region in zip(readers, m.regions)]
+        log_products.append(sum(np.log(reader.region_confidence(region, voted)[1])
+                                for reader, region, voted in zip(readers, m.regions, votes)))
+        right.append(sum(voted[0][1] for voted in votes) == m.true_betti1)
     return np.array(log_products, dtype=float), np.array(right, dtype=bool)
 
 
