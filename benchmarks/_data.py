@@ -12,7 +12,7 @@ target at the measured event rate (0.39 events per agent-second at 200 agents,
 a margin.  The log is then cut at the time of its ``n_events``-th event (events and
 status changes after it dropped), so it holds the target number of events (a few more
 when several events share that time step).  A 10^6-event log takes 13-18 s to
-simulate; it is written once with ``swarmtopo.io.write_log(fmt="parquet")`` under
+simulate; it is written once with ``swarmtopo.io.logs.write_log(fmt="parquet")`` under
 ``$SWARMTOPO_BENCH_CACHE`` (default ``~/.cache/swarmtopo-bench``), in a folder named
 after every parameter and a hash of the simulator's source (``swarmtopo/sim/*.py``
 and ``arena.py``: a changed model gives a new log), and read back afterwards.
@@ -35,9 +35,9 @@ import numpy as np
 
 import swarmtopo
 from swarmtopo.arena import random_arena
-from swarmtopo.graph import build_graph
-from swarmtopo.io import read_log, write_log
-from swarmtopo.landmarks import maxmin
+from swarmtopo.metric.graph import build_graph
+from swarmtopo.io.logs import read_log, write_log
+from swarmtopo.metric.landmarks import maxmin
 from swarmtopo.log import EncounterLog
 from swarmtopo.sim import simulate
 

@@ -23,9 +23,9 @@ import numpy as np
 
 from _data import simulated_log
 from _measure import machine, revision
-from swarmtopo import pipeline
-from swarmtopo.landmarks import covering_prefix
-from swarmtopo.pipeline import MapConfig, map_encounters
+from swarmtopo.pipeline import map as pipeline
+from swarmtopo.metric.landmarks import covering_prefix
+from swarmtopo.pipeline.map import MapConfig, map_encounters
 
 SHIPPED = pipeline._subsample
 

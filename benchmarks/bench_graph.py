@@ -28,7 +28,7 @@ import numpy as np
 
 from _data import simulated_log
 from _measure import machine, revision, run_measured
-from swarmtopo.graph import METRICS, build_graph, literal_distances
+from swarmtopo.metric.graph import METRICS, build_graph, literal_distances
 
 REPEATS = 3
 

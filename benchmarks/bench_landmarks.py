@@ -33,8 +33,8 @@ from scipy.sparse.csgraph import dijkstra, shortest_path
 from scipy.spatial import cKDTree
 
 from _measure import run_measured
-from swarmtopo.graph import build_graph
-from swarmtopo.landmarks import SUBSAMPLERS, knn_distances, maxmin
+from swarmtopo.metric.graph import build_graph
+from swarmtopo.metric.landmarks import SUBSAMPLERS, knn_distances, maxmin
 from swarmtopo.log import EncounterLog
 
 N_LANDMARKS = 500

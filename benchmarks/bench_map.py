@@ -1,6 +1,6 @@
 """The whole map (issue 3's figure): 10^6 simulated events, 500 landmarks, H0 + H1.
 
-Part 1 (10^6 events, ``--quick``: 10^5): ``swarmtopo.pipeline.map_encounters`` on a
+Part 1 (10^6 events, ``--quick``: 10^5): ``swarmtopo.pipeline.map.map_encounters`` on a
 simulated two-hole log (``_data.simulated_log``: 2,000 agents at the paper's density,
 10 % static) with ``MapConfig(metric, subsample, landmarks=500, maxdim=1,
 embed_dim=0)`` for the three subsamplers, on the plain and the hybrid metric (the
@@ -38,9 +38,9 @@ import numpy as np
 from _data import simulated_log
 from _measure import machine, revision, run_measured
 from bench_landmarks import compare_with_dense
-from swarmtopo.graph import build_graph
-from swarmtopo.landmarks import SUBSAMPLERS
-from swarmtopo.pipeline import MapConfig, map_encounters, max_windows_option
+from swarmtopo.metric.graph import build_graph
+from swarmtopo.metric.landmarks import SUBSAMPLERS
+from swarmtopo.pipeline.map import MapConfig, map_encounters, max_windows_option
 
 N_LANDMARKS = 500
 METRICS = ("plain", "hybrid")

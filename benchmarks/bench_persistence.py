@@ -4,7 +4,7 @@ The matrices are real: maxmin landmarks (L = 150 ... 2,000, each a prefix of the
 largest set) of the hybrid encounter metric of a simulated two-hole log of 10^5
 events (``_data.landmark_matrices``; cached after the first run, which takes about a
 minute).  For each L, every installed backend runs through the adapter
-(``swarmtopo.persistence.rips_persistence``, maxdim 1) on the same matrix; the table
+(``swarmtopo.topology.persistence.rips_persistence``, maxdim 1) on the same matrix; the table
 gives medians of repeats, the ratio of the default backend ("auto") to the fastest
 (target <= 1.2), the raw library time of the default (adapter overhead), whether all
 backends returned identical diagrams, and the three longest H1 bars (two holes).
@@ -22,7 +22,7 @@ import numpy as np
 
 from _data import landmark_matrices
 from _measure import machine, revision
-from swarmtopo.persistence import available_backends, rips_persistence
+from swarmtopo.topology.persistence import available_backends, rips_persistence
 
 SIZES = (150, 300, 500, 1000, 2000)
 QUICK_SIZES = (150, 300, 500)

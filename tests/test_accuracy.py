@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 from scipy.stats import binom
 
-from swarmtopo.classify import load_classifier
+from swarmtopo.readers.paper import load_classifier
 from swarmtopo.errors import SwarmtopoError
 from swarmtopo.experiments import accuracy as acc
 from swarmtopo.experiments.grid import canonical_json
 from swarmtopo.experiments.sweep import run_job
-from swarmtopo.pipeline import fitted_landmark_bands
+from swarmtopo.pipeline.map import fitted_landmark_bands
 
 ROOT = Path(__file__).resolve().parent.parent
 DOC = ROOT / "docs" / "accuracy.md"
@@ -134,8 +134,8 @@ def test_table_and_reliability_hand_computed():
 
 
 def test_outcomes_read_a_two_region_map_by_the_classifiers_power_of_the_product():
-    from swarmtopo.persistence import Diagram
-    from swarmtopo.ratio import map_confidence, vote
+    from swarmtopo.topology.persistence import Diagram
+    from swarmtopo.readers.ratio import map_confidence, vote
 
     def region(long_bar):  # three windows, ten noise loops each, and one long loop or none
         rng = np.random.default_rng(int(long_bar))
@@ -229,9 +229,9 @@ def test_benchmark_runs_both_pipelines_on_dask_and_renders_its_table(tmp_path):
     assert again["jobs_run"] == 1 and again["records"] == summary["records"]  # resumed: only the grid's map runs
     assert [(r["agents"], r["duration"], r["true_betti1"]) for r in again["planning"]] == [(200, 15.0, 0)]
     assert "| 200 x 15 s | " in acc.markdown(again, "swarmtopo bench accuracy --test")
-    # benchmarks/reclassify.py reads the same default-pipeline maps back from the store's
+    # lab/reclassify.py reads the same default-pipeline maps back from the store's
     # columns: under the shipped classifier they give the bench's own records
-    spec = importlib.util.spec_from_file_location("reclassify", ROOT / "benchmarks" / "reclassify.py")
+    spec = importlib.util.spec_from_file_location("reclassify", ROOT / "lab" / "reclassify.py")
     reclassify = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(reclassify)
     rows = reclassify.default_rows(str(tmp_path / "acc.duckdb"))
@@ -248,7 +248,7 @@ def test_benchmark_runs_both_pipelines_on_dask_and_renders_its_table(tmp_path):
 def test_contact_trace_keeps_only_the_encounters_and_maps_from_them():
     from swarmtopo.arena import default_arena
     from swarmtopo.experiments.sweep import contact_trace
-    from swarmtopo.pipeline import HOP_GAP_FACTOR, resolve_hop_cost
+    from swarmtopo.pipeline.map import HOP_GAP_FACTOR, resolve_hop_cost
     from swarmtopo.sim import simulate
 
     log = simulate(default_arena(), 60, 10.0, static_fraction=0.2, rng=1).log

@@ -4,10 +4,10 @@ is free of rotation and reflection, overlaps and ranks by hand, and in the pipel
 import numpy as np
 import pytest
 
-from swarmtopo import agreement
-from swarmtopo.agreement import BARS, PRIME, circular_coordinates, overlapping, pair_agreement, rank_agreement
+from swarmtopo.readers import agreement
+from swarmtopo.readers.agreement import BARS, PRIME, circular_coordinates, overlapping, pair_agreement, rank_agreement
 from swarmtopo.errors import InputError
-from swarmtopo.persistence import rips_persistence
+from swarmtopo.topology.persistence import rips_persistence
 
 
 def circle(n=120, noise=0.03, seed=0):
@@ -93,7 +93,7 @@ def test_rank_agreement_by_hand():
 
 
 def test_a_window_without_h1_bars_has_no_coordinates():
-    from swarmtopo.persistence import Diagram
+    from swarmtopo.topology.persistence import Diagram
 
     class Graph:  # the one attribute of an EncounterGraph read when there is no bar
         event_index = np.arange(4)

@@ -20,7 +20,7 @@ from swarmtopo.arena import (
     two_rooms_arena,
 )
 from swarmtopo.errors import ArenaError, InputError, SwarmtopoError
-from swarmtopo.io import read_arena, write_arena
+from swarmtopo.io.logs import read_arena, write_arena
 
 
 def ring_hole(x0, y0, x1, y1):
@@ -463,7 +463,7 @@ def test_a_room_inside_a_hole_is_drawn_as_free_space():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from swarmtopo.plotting import plot_arena
+    from swarmtopo.viz.plots import plot_arena
 
     arena = Arena(MultiPolygon([Polygon(box(0, 0, 600, 600).exterior, [box(150, 150, 450, 450).exterior]),
                                 box(250, 250, 350, 350)]))

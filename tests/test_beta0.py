@@ -1,4 +1,4 @@
-"""beta_0's evidence and confidence (swarmtopo.beta0)."""
+"""beta_0's evidence and confidence (swarmtopo.readers.beta0)."""
 
 import json
 
@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 
 from swarmtopo.arena import square_arena, two_rooms_arena
-from swarmtopo.beta0 import FORMED_SHARE, Beta0Evidence, Beta0Model, beta0_evidence, formation_times, shipped_beta0_model
-from swarmtopo.classify import load_classifier
+from swarmtopo.readers.beta0 import FORMED_SHARE, Beta0Evidence, Beta0Model, beta0_evidence, formation_times, shipped_beta0_model
+from swarmtopo.readers.paper import load_classifier
 from swarmtopo.errors import InputError
 from swarmtopo.experiments.sweep import contact_trace
-from swarmtopo.pipeline import MapConfig, map_encounters, split_regions
+from swarmtopo.pipeline.map import MapConfig, map_encounters, split_regions
 from swarmtopo.sim import simulate
 
 FAST = {"max_landmarks": 80, "window_scales": (1.0,)}
@@ -105,7 +105,7 @@ def test_a_bad_model_file_is_refused_naming_the_field(part, key, value):
 
 def test_shipped_model_is_fitted_so_that_more_evidence_means_more_confidence():
     model = shipped_beta0_model()
-    assert model.provenance["script"] == "scripts/calibrate_beta0.py"
+    assert model.provenance["script"] == "lab/calibrate_beta0.py"
     assert model.several[1] > 0 and model.one[1] < 0
 
 

@@ -9,12 +9,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from sklearn.base import clone
 
-from swarmtopo.classify import (
+from swarmtopo.readers.paper import (
     PAPER_THETA, BettiClassifier, Theta, betti_function, detection_scores, load_classifier,
     mean_absolute_error, paper_classifier, _best_tau,
 )
 from swarmtopo.errors import InputError, SwarmtopoError
-from swarmtopo.persistence import Diagram
+from swarmtopo.topology.persistence import Diagram
 
 
 def diagram(h1_lengths, birth=1.0) -> Diagram:
@@ -175,7 +175,7 @@ def test_confidence_grows_with_the_margin_and_stays_in_unit_interval():
 
 
 def test_confidence_features_hand_case():
-    from swarmtopo.classify import MAX_MARGIN, confidence_features
+    from swarmtopo.readers.paper import MAX_MARGIN, confidence_features
 
     # median of [8, 2, 1, 1, 1] is 1; tau = 4: ratio 8 is counted (ln 2 above), 2 is the
     # longest uncounted (ln 2 below): margin ln 2, gap ln 4

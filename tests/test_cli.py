@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from swarmtopo.classify import load_classifier
-from swarmtopo.io import read_log, strip_ground_truth
-from swarmtopo.pipeline import MapConfig, fitted_landmark_bands
+from swarmtopo.readers.paper import load_classifier
+from swarmtopo.io.logs import read_log, strip_ground_truth
+from swarmtopo.pipeline.map import MapConfig, fitted_landmark_bands
 
 
 def run(*args, cwd=None):
@@ -253,7 +253,7 @@ def test_runs_too_big_are_refused_naming_the_options(tmp_path):
 def test_the_limits_the_cli_states_without_importing_them_are_the_librarys():
     """The CLI keeps its start-up light by stating these limits in its own code and help."""
     from swarmtopo import cli
-    from swarmtopo.pipeline import MAX_LANDMARKS
+    from swarmtopo.pipeline.map import MAX_LANDMARKS
     from swarmtopo.sim.simulate import MAX_AGENT_STEPS, MAX_AGENTS
 
     assert cli.MAX_LANDMARKS_OPTION == MAX_LANDMARKS
@@ -262,7 +262,7 @@ def test_the_limits_the_cli_states_without_importing_them_are_the_librarys():
 
 
 def test_simulate_scales_a_file_arena_and_refuses_holes_with_it(tmp_path):
-    from swarmtopo.io import read_arena
+    from swarmtopo.io.logs import read_arena
 
     path = tmp_path / "arena.geojson"
     path.write_text(json.dumps({"type": "Polygon", "coordinates": [

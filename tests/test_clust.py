@@ -6,11 +6,11 @@ import json
 import numpy as np
 import pytest
 
-from swarmtopo.classify import PAPER_THETA, betti_function
+from swarmtopo.readers.paper import PAPER_THETA, betti_function
 from swarmtopo.experiments.clust import HOLES, SCALES, clust_sweeps
 from swarmtopo.experiments.reproduce import reproduce
 from swarmtopo.experiments.store import read_jobs
-from swarmtopo.persistence import Diagram
+from swarmtopo.topology.persistence import Diagram
 
 
 def test_sweeps_share_the_two_hole_scale_one_test_set_and_not_the_training_set():

@@ -1,4 +1,4 @@
-"""Representative cycles of H1 bars (swarmtopo.cycles)."""
+"""Representative cycles of H1 bars (swarmtopo.topology.cycles)."""
 
 import itertools
 
@@ -8,11 +8,11 @@ import pytest
 import shapely
 
 from swarmtopo.arena import default_arena
-from swarmtopo.cycles import (Cycle, encircled_obstacles, event_positions, localization_scores, odd_winding,
+from swarmtopo.topology.cycles import (Cycle, encircled_obstacles, event_positions, localization_scores, odd_winding,
                               region_cycles, representative_cycles, shortest_odd_loop, wilson_interval)
 from swarmtopo.errors import InputError
-from swarmtopo.persistence import rips_persistence
-from swarmtopo.pipeline import MapConfig, map_encounters
+from swarmtopo.topology.persistence import rips_persistence
+from swarmtopo.pipeline.map import MapConfig, map_encounters
 from swarmtopo.sim import simulate
 
 

@@ -1,4 +1,4 @@
-"""Tests of swarmtopo.embed: exact recovery, optimality against a known family,
+"""Tests of swarmtopo.topology.embed: exact recovery, optimality against a known family,
 monotonicity of SMACOF, determinism, validation."""
 
 import numpy as np
@@ -7,7 +7,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import shortest_path
 from scipy.spatial.distance import cdist
 
-from swarmtopo.embed import Embedding, kruskal_stress, mds
+from swarmtopo.topology.embed import Embedding, kruskal_stress, mds
 from swarmtopo.errors import InputError
 
 

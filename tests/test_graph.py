@@ -10,7 +10,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from swarmtopo.errors import InputError
-from swarmtopo.graph import METRICS, EncounterGraph, build_graph, literal_distances, state_time
+from swarmtopo.metric.graph import METRICS, EncounterGraph, build_graph, literal_distances, state_time
 from swarmtopo.log import RW, S, STATES, WF, EncounterLog
 
 INF = np.inf

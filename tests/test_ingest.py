@@ -15,8 +15,8 @@ import pyarrow.parquet as pq
 import pytest
 
 from swarmtopo.errors import InputError, SwarmtopoError
-from swarmtopo.ingest import ingest
-from swarmtopo.io import read_log, write_log
+from swarmtopo.io.traces import ingest
+from swarmtopo.io.logs import read_log, write_log
 
 SCRIPT = "<script>alert(1)</script>"
 
@@ -175,7 +175,7 @@ def test_streaming_blocks_give_the_same_log_as_one_block(tmp_path, monkeypatch):
     lines = [f"{20 * k} {i} {j} X X" for k, (i, j) in enumerate(rng.integers(0, 9, (400, 2)), 1) if i != j]
     path = write(tmp_path, "tij.dat", "\n".join(lines[:150] + ["oops"] + lines[150:]) + "\n")
     whole, whole_report = ingest(path, "sociopatterns", skip_bad=True)
-    monkeypatch.setattr("swarmtopo.ingest._BLOCK", 97)
+    monkeypatch.setattr("swarmtopo.io.traces._BLOCK", 97)
     small, small_report = ingest(path, "sociopatterns", skip_bad=True)
     assert events(whole) == events(small) and whole_report == small_report
     assert small_report.examples[0].split(", ")[1] == "row 151"
@@ -224,7 +224,7 @@ def test_csv_streaming_blocks_keep_row_numbers(tmp_path, monkeypatch):
     rows[49] = "50,a1"        # data row 50: two fields
     rows[199] = "x200,a1,b1"  # data row 200: bad time
     path = write(tmp_path, "trace.csv", "t,a,b\n" + "\n".join(rows) + "\n")
-    monkeypatch.setattr("swarmtopo.ingest._BLOCK", 100)
+    monkeypatch.setattr("swarmtopo.io.traces._BLOCK", 100)
     log, report = ingest(path, "csv", skip_bad=True)
     assert report.skipped == 2 and log.n_events == 297 and report.lines == 299
     assert [e.split(", ")[1] for e in report.examples] == ["row 50", "row 200"]
@@ -420,7 +420,7 @@ def test_crlf_split_across_blocks_is_one_line_end(tmp_path, monkeypatch):
     path = write(tmp_path, "tij.dat", raw, "wb")
     whole, whole_report = ingest(path, "sociopatterns")
     for block in (5, 9, 10, 11):  # cuts before, at and after the \r\n of 8-11 byte lines
-        monkeypatch.setattr("swarmtopo.ingest._BLOCK", block)
+        monkeypatch.setattr("swarmtopo.io.traces._BLOCK", block)
         small, small_report = ingest(path, "sociopatterns")
         assert events(small) == events(whole) and small_report == whole_report
     assert whole_report.lines == 199 and whole_report.counts["blank_lines"] == 0
@@ -439,7 +439,7 @@ def test_a_broken_gzip_trace_is_one_line_naming_the_file(tmp_path, fmt, name, ra
 
 
 def test_not_utf8_mask_agrees_with_decoding_each_value():
-    from swarmtopo.ingest import _not_utf8
+    from swarmtopo.io.traces import _not_utf8
     values = [b"ok", b"Cr\xe8che", None, "é".encode(), b"\xff", b""] * 50
     expected = [v is not None and not _decodes_literally(v) for v in values]
     assert _not_utf8(pa.array(values, pa.binary())).tolist() == expected

@@ -15,7 +15,7 @@ import pytest
 
 from swarmtopo.arena import default_arena
 from swarmtopo.errors import InputError, SwarmtopoError
-from swarmtopo.io import (
+from swarmtopo.io.logs import (
     GROUND_TRUTH_FILES,
     LOG_FORMAT,
     jsonable,

@@ -10,8 +10,8 @@ from scipy.sparse.csgraph import connected_components, shortest_path
 from scipy.spatial import cKDTree
 
 from swarmtopo.errors import InputError, SwarmtopoError
-from swarmtopo.graph import build_graph, literal_distances
-from swarmtopo.landmarks import (SUBSAMPLERS, Landmarks, covering_prefix, knn_distances, knn_maxmin, maxmin,
+from swarmtopo.metric.graph import build_graph, literal_distances
+from swarmtopo.metric.landmarks import (SUBSAMPLERS, Landmarks, covering_prefix, knn_distances, knn_maxmin, maxmin,
                                  probabilistic_maxmin)
 from swarmtopo.log import EncounterLog
 
@@ -172,7 +172,7 @@ def test_cover_stops_the_run_at_its_first_covering_prefix(subsample, quantile):
 def test_lower_distances_is_exact_up_to_its_limit():
     # the invariant of _kernels.lower_distances: after each landmark with limit r,
     # to_set = d(x, L) where d(x, L) <= r, and to_set >= d(x, L) elsewhere
-    from swarmtopo._kernels import Searcher
+    from swarmtopo.metric._kernels import Searcher
     g = random_geometric_graph(300, 3, radius=0.12)
     d = dense(g)
     a = g.adjacency

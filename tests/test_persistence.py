@@ -1,4 +1,4 @@
-"""Tests of swarmtopo.persistence: hand-computed diagrams, backend agreement,
+"""Tests of swarmtopo.topology.persistence: hand-computed diagrams, backend agreement,
 the stability theorem, conventions, validation."""
 
 import json
@@ -10,7 +10,7 @@ from scipy.sparse.csgraph import shortest_path
 from scipy.spatial.distance import cdist
 
 from swarmtopo.errors import InputError, SwarmtopoError
-from swarmtopo.persistence import (
+from swarmtopo.topology.persistence import (
     BACKENDS,
     Diagram,
     available_backends,
@@ -306,7 +306,7 @@ def test_rounding_noise_bars_are_dropped_relative_to_the_diagram_scale():
 
 def test_simulated_maps_have_no_rounding_noise_bars():
     from swarmtopo.arena import random_arena
-    from swarmtopo.pipeline import MapConfig, map_encounters
+    from swarmtopo.pipeline.map import MapConfig, map_encounters
     from swarmtopo.sim import simulate
 
     sim = simulate(random_arena(2, rng=0), 200, 30.0, rng=0)
@@ -325,7 +325,7 @@ def snr_diagram():
 
 
 def test_snr_hand_computed():
-    from swarmtopo.persistence import snr
+    from swarmtopo.topology.persistence import snr
 
     s = snr(snr_diagram(), 1, 1)
     # signal: the longest bar (4) -> P_S = 16; noise: 1 and 0.5 -> P_N = (1 + 0.25) / 2
@@ -335,7 +335,7 @@ def test_snr_hand_computed():
 
 
 def test_snr_without_signal_is_the_noise_power_alone():
-    from swarmtopo.persistence import snr
+    from swarmtopo.topology.persistence import snr
 
     s = snr(snr_diagram(), 1, 0)
     assert s.signal_power == 0 and s.ratio == 0
@@ -343,7 +343,7 @@ def test_snr_without_signal_is_the_noise_power_alone():
 
 
 def test_snr_caps_infinite_bars_and_handles_missing_noise():
-    from swarmtopo.persistence import snr
+    from swarmtopo.topology.persistence import snr
 
     # the infinite H0 bar counts as long as the largest finite death (5) minus its birth
     s = snr(snr_diagram(), 0, 1)
@@ -355,7 +355,7 @@ def test_snr_caps_infinite_bars_and_handles_missing_noise():
 
 
 def test_mean_snr_averages_the_ratios_of_independent_runs():
-    from swarmtopo.persistence import mean_snr, snr
+    from swarmtopo.topology.persistence import mean_snr, snr
 
     other = Diagram(pairs=(np.array([[0.0, np.inf]]), np.array([[0.0, 2.0], [0.0, 1.0]])), backend="t")
     assert mean_snr([snr_diagram(), other], 1, 1) == pytest.approx((25.6 + 4.0) / 2)

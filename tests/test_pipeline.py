@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 
 from swarmtopo.arena import default_arena, square_arena, two_rooms_arena
-from swarmtopo.classify import load_classifier
+from swarmtopo.readers.paper import load_classifier
 from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.log import EncounterLog
-from swarmtopo.pipeline import (DIFFUSION_GAP_FACTOR, HOP_GAP_FACTOR, WHOLE_LOG, MapConfig, _share_landmarks,
+from swarmtopo.pipeline.map import (DIFFUSION_GAP_FACTOR, HOP_GAP_FACTOR, WHOLE_LOG, MapConfig, _share_landmarks,
                                 _scaled_windows, _windows, map_encounters, mean_agent_gap, resolve_diffusion_time, resolve_hop_cost,
                                 fitted_landmark_bands, resolve_window, shipped_classifier_for)
-from swarmtopo.ratio import RatioClassifier, RatioThresholds, region_reader
+from swarmtopo.readers.ratio import RatioClassifier, RatioThresholds, region_reader
 from swarmtopo.sim import simulate
 
 FAST = dict(embed_dim=0, landmark_bands=(1.0,))
@@ -65,7 +65,7 @@ def test_simulated_arenas_map_to_their_hole_count(arena, holes, recorded):
 
     A regression guard at the level recorded with the shipped classifier: one-hole
     7/10, no-hole 8/10 (17/20 and 16/20 over seeds 0-19 in
-    ``benchmarks/demo_accuracy.py``; one-hole 8/10 and 18/20 before the landmark bands).  20 s is shorter than an automatic window of
+    ``lab/demo_accuracy.py``; one-hole 8/10 and 18/20 before the landmark bands).  20 s is shorter than an automatic window of
     scale 1 (scales 1 and 1.25 map the log whole, 0.75 in two windows), and below the
     accuracy benchmark's smallest budget (docs/accuracy.md).
     beta_0 must always be 1.  The seeds are fixed, so the test is deterministic.
@@ -201,9 +201,9 @@ def test_landmark_shares_follow_events_with_a_minimum_of_three():
 def test_landmark_diagram_within_twice_the_cover_radius_of_the_full_cloud(metric, n_landmarks):
     """Theorem: landmarks that are r-dense in the cloud give a Rips diagram within
     bottleneck distance 2r of the whole cloud's (Chazal, de Silva, Oudot 2014)."""
-    from swarmtopo.graph import build_graph
-    from swarmtopo.landmarks import maxmin
-    from swarmtopo.persistence import bottleneck, rips_persistence
+    from swarmtopo.metric.graph import build_graph
+    from swarmtopo.metric.landmarks import maxmin
+    from swarmtopo.topology.persistence import bottleneck, rips_persistence
 
     log = simulate(default_arena(), 150, 8.0, rng=11, static_fraction=0.1).log
     graph = build_graph(log, metric)
@@ -218,7 +218,7 @@ def test_landmark_diagram_within_twice_the_cover_radius_of_the_full_cloud(metric
 
 
 def test_automatic_landmarks_are_the_shortest_prefix_meeting_the_guarantee():
-    from swarmtopo.pipeline import AUTO_COVER_FACTOR
+    from swarmtopo.pipeline.map import AUTO_COVER_FACTOR
 
     log = simulate(default_arena(), 200, 20.0, rng=5).log
     auto = map_encounters(log, MapConfig(seed=1, **FAST)).regions[0]
@@ -272,7 +272,7 @@ def test_capped_windows_keep_an_even_share_of_every_length():
 
 
 def test_window_shares_sum_to_the_cap_and_keep_one_per_length():
-    from swarmtopo.pipeline import _shares
+    from swarmtopo.pipeline.map import _shares
 
     # 48 x (399, 3, 2) / 404 = (47.41, 0.36, 0.24): the floors (47, 0, 0) raised to one each exceed
     # the cap, so the largest share gives one back
@@ -288,7 +288,7 @@ def test_window_shares_sum_to_the_cap_and_keep_one_per_length():
 def test_a_long_log_maps_at_most_max_windows():
     import dataclasses
 
-    from swarmtopo.pipeline import ADVICE_BELOW
+    from swarmtopo.pipeline.map import ADVICE_BELOW
 
     log = simulate(default_arena(), 150, 30.0, rng=2).log
     base = dict(window_length=6.0, window_scales=(1.0, 1.5), **FAST)
@@ -516,8 +516,8 @@ def test_a_log_without_status_changes_is_read_by_the_trace_classifier():
 def test_advice_comes_below_the_threshold_and_names_what_would_raise_it():
     import dataclasses
 
-    from swarmtopo.pipeline import ADVICE_BELOW
-    from swarmtopo.ratio import RESOLUTION_CAP, resolution
+    from swarmtopo.pipeline.map import ADVICE_BELOW
+    from swarmtopo.readers.ratio import RESOLUTION_CAP, resolution
 
     log = simulate(default_arena(), 150, 30.0, rng=2).log
     tmap = map_encounters(log, MapConfig(window_length=12.0, window_scales=(1.0,), **FAST))
@@ -595,7 +595,7 @@ def test_landmarks_below_the_sampling_guarantee_warn_and_give_no_beta1_confidenc
 
 def test_a_hole_count_beyond_the_calibrated_arenas_is_flagged():
     from swarmtopo.experiments.accuracy import CELLS
-    from swarmtopo.pipeline import CALIBRATED_HOLES, _extrapolation_warnings
+    from swarmtopo.pipeline.map import CALIBRATED_HOLES, _extrapolation_warnings
 
     assert CALIBRATED_HOLES == max(c.holes for c in CELLS if c.holes is not None)
     assert _extrapolation_warnings({0: 1, 1: CALIBRATED_HOLES}) == []

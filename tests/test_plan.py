@@ -8,7 +8,7 @@ from typer.testing import CliRunner
 
 from swarmtopo.cli import app
 from swarmtopo.errors import InputError, SwarmtopoError
-from swarmtopo.plan import PlanModel, fit_plan, load_plan
+from swarmtopo.experiments.plan import PlanModel, fit_plan, load_plan
 
 runner = CliRunner()
 

@@ -5,13 +5,13 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from swarmtopo.classify import load_classifier
+from swarmtopo.readers.paper import load_classifier
 from swarmtopo.errors import InputError, SwarmtopoError
-from swarmtopo.persistence import Diagram
+from swarmtopo.topology.persistence import Diagram
 from scipy.special import expit
 
-from swarmtopo.pipeline import MapConfig, fitted_landmark_bands
-from swarmtopo.ratio import (LOG_RATIO_CAP, MAX_MARGIN, REGIONS_EXPONENT, RESOLUTION_CAP, SCORE_VAR_PRIOR, Z_CAP,
+from swarmtopo.pipeline.map import MapConfig, fitted_landmark_bands
+from swarmtopo.readers.ratio import (LOG_RATIO_CAP, MAX_MARGIN, REGIONS_EXPONENT, RESOLUTION_CAP, SCORE_VAR_PRIOR, Z_CAP,
                              RatioClassifier, RatioThresholds, SPAN_FEATURES, below_full_resolution, calibrated_probability,
                              confidence_readout, longest_bars, map_confidence, median_vote, pooled_scores, region_reader,
                              resolution, windows_span,
@@ -333,7 +333,7 @@ def test_bad_thresholds_and_files_are_input_errors():
 def test_shipped_default_is_a_calibrated_mean_pooled_ratio_classifier_and_gated_its_gated_variant():
     model = load_classifier("default")
     assert isinstance(model, RatioClassifier) and model.pooling == "mean"
-    assert set(model.calibration_) == {"1"}  # beta_0's confidence is the pipeline's (swarmtopo.beta0)
+    assert set(model.calibration_) == {"1"}  # beta_0's confidence is the pipeline's (swarmtopo.readers.beta0)
     assert not model.gated and not load_classifier("trace").gated  # the score alone
     gated = load_classifier("gated")
     assert gated.gated and 0 < gated.thresholds_[1].agreement < 1 and set(gated.calibration_) == {"1"}

@@ -19,9 +19,9 @@ import pytest
 
 from swarmtopo.arena import default_arena
 from swarmtopo.log import EncounterLog, state_labels
-from swarmtopo.pipeline import MapConfig, map_encounters
-from swarmtopo.report import write_map_outputs
-from swarmtopo.report_html import MAX_ANIMATION_AGENTS, percent, script_json
+from swarmtopo.pipeline.map import MapConfig, map_encounters
+from swarmtopo.viz.report import write_map_outputs
+from swarmtopo.viz.report_html import MAX_ANIMATION_AGENTS, percent, script_json
 from swarmtopo.sim import simulate
 
 EVIL = "<script>alert(1)</script>"
@@ -158,7 +158,7 @@ def test_cloud_and_arena_figures(demo):
 def test_real_data_report_has_no_ground_truth_sections(demo, embed_dim):
     """A deployment's log: no arena, truth or trajectories -> no true Betti numbers,
     no arena or animation; a 2-D MDS picture is a plain scatter, embed_dim 0 none."""
-    from swarmtopo.report_html import report_html
+    from swarmtopo.viz.report_html import report_html
 
     tmap = map_encounters(demo["sim"].log, MapConfig(seed=0, embed_dim=embed_dim, cycles=False))
     page = report_html(tmap, log=demo["sim"].log)
@@ -426,7 +426,7 @@ def test_report_renders_in_headless_chromium(demo, evil, tmp_path):
 
 def test_a_contact_trace_report_speaks_of_contact_loops_not_obstacles(demo):
     from swarmtopo.experiments.sweep import contact_trace
-    from swarmtopo.report_html import report_html
+    from swarmtopo.viz.report_html import report_html
 
     log = contact_trace(demo["sim"].log)
     tmap = map_encounters(log, MapConfig(seed=0, embed_dim=2, cycles=False))

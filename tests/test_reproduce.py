@@ -7,17 +7,17 @@ import csv
 import numpy as np
 import pytest
 
-from swarmtopo.classify import load_classifier
+from swarmtopo.readers.paper import load_classifier
 
 from swarmtopo.arena import default_arena
-from swarmtopo.cycles import event_positions
+from swarmtopo.topology.cycles import event_positions
 from swarmtopo.errors import InputError
 from swarmtopo.experiments import reproduce as rp
-from swarmtopo.graph import build_graph
-from swarmtopo.landmarks import maxmin
-from swarmtopo.persistence import Diagram, rips_persistence, snr
-from swarmtopo.pipeline import WHOLE_LOG, MapConfig, map_encounters
-from swarmtopo.plotting import cyclic_colors, new_figure, plot_bar_separation, plot_distributions
+from swarmtopo.metric.graph import build_graph
+from swarmtopo.metric.landmarks import maxmin
+from swarmtopo.topology.persistence import Diagram, rips_persistence, snr
+from swarmtopo.pipeline.map import WHOLE_LOG, MapConfig, map_encounters
+from swarmtopo.viz.plots import cyclic_colors, new_figure, plot_bar_separation, plot_distributions
 from swarmtopo.sim import simulate
 
 

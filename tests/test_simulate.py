@@ -9,7 +9,7 @@ from shapely.geometry import Polygon, box
 
 import swarmtopo
 from swarmtopo import Arena, InputError
-from swarmtopo.io import LOG_FORMAT
+from swarmtopo.io.logs import LOG_FORMAT
 from swarmtopo.log import RW, S, WF
 from swarmtopo.sim import Command, MotionParams, SensingParams, interpreted_kernels, simulate
 

@@ -24,7 +24,7 @@ from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.experiments.grid import PARAMS, STORE_INT_MAX, expand_grid, read_sweep
 from swarmtopo.experiments.store import RUN_COLUMNS, ResultStore, read_jobs
 from swarmtopo.experiments.sweep import job_map_config, run_job, run_sweep
-from swarmtopo.pipeline import MapConfig
+from swarmtopo.pipeline.map import MapConfig
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "sweep-small.toml"
 
@@ -297,8 +297,8 @@ def test_input_files_enter_the_key_by_content_and_reach_the_job(tmp_path):
     import shapely
 
     from swarmtopo.arena import square_arena
-    from swarmtopo.classify import BettiClassifier
-    from swarmtopo.io import write_arena
+    from swarmtopo.readers.paper import BettiClassifier
+    from swarmtopo.io.logs import write_arena
 
     write_arena(square_arena(400.0, [shapely.box(150, 150, 250, 250)]), tmp_path / "room.geojson")
     BettiClassifier.from_theta({1: (0.5, 0.0, 1e9)}, {"name": "blind"}).save(tmp_path / "theta.json")  # no hole

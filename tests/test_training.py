@@ -4,12 +4,12 @@ optimizer chosen on held-out maps."""
 import numpy as np
 import pytest
 
-from swarmtopo.classify import detection_scores
+from swarmtopo.readers.paper import detection_scores
 from swarmtopo.experiments.grid import expand_grid
 from swarmtopo.experiments.training import (
     DEFAULT_TRAINING, Examples, examples_from_rows, fit_and_select, heldout_sweep,
 )
-from swarmtopo.persistence import Diagram
+from swarmtopo.topology.persistence import Diagram
 
 
 def row(true_b0, true_b1, est_b0, h1_lengths, error=None):

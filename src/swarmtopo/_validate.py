@@ -68,7 +68,7 @@ def check_format(obj, expected: str | tuple[str, ...], what: str, source: str) -
 
 def file_calibration(calibration, source: str) -> dict:
     """A classifier file's ``calibration`` object ({dimension: model}; none: {}) without
-    earlier files' "0" (beta_0's confidence is now the pipeline's, swarmtopo.beta0); a
+    earlier files' "0" (beta_0's confidence is now the pipeline's, swarmtopo.readers.beta0); a
     value that is not an object is refused naming ``source``."""
     if not calibration:
         return {}

@@ -49,7 +49,7 @@ def _write_log_folder(log, out_dir: Path, quiet: bool, overwrite: bool, protect=
     """``io.write_log`` into a folder without a log, or over one with ``overwrite``,
     saying which outdated log files of the folder it removed; never over a file of
     ``protect`` (the trace an ingest reads)."""
-    from .io import log_files, refuse_protected, write_log
+    from .io.logs import log_files, refuse_protected, write_log
 
     refuse_protected(out_dir, protect)  # before --overwrite could be suggested
     before = set(log_files(out_dir))
@@ -165,7 +165,7 @@ def simulate(
     import time
 
     from .arena import random_arena
-    from .io import read_arena
+    from .io.logs import read_arena
     from .sim import (MotionParams, SensingParams, check_run_size, check_static_time, check_time_step,
                       simulate as run)
 
@@ -230,7 +230,7 @@ def ingest(
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
     """Convert a proximity trace into an encounter log folder (see docs/real-data.md)."""
-    from .ingest import FORMATS, SOCIOPATTERNS_WINDOW, ingest as read_trace
+    from .io.traces import FORMATS, SOCIOPATTERNS_WINDOW, ingest as read_trace
     from .log import exact_time
 
     _check_verbosity(quiet, verbose)
@@ -282,7 +282,7 @@ def _parse_window(text: Optional[str]):
 
 def _hop_cost_option(value: Optional[float]) -> Optional[float]:
     """A --hop-cost value: seconds in [0, MAX_HOP_COST]."""
-    from .pipeline import MAX_HOP_COST
+    from .pipeline.map import MAX_HOP_COST
 
     if value is not None and not (math.isfinite(value) and value <= MAX_HOP_COST):
         raise typer.BadParameter(f"{value:g} is not a number of seconds in [0, {MAX_HOP_COST:g}]")
@@ -297,7 +297,7 @@ def _parse_wall_follow_weight(text: Optional[str]):
         value = float(text)
     except ValueError:
         raise typer.BadParameter(f"{text!r} is not a number or 'none'") from None
-    from .pipeline import MAX_WALL_FOLLOW_WEIGHT
+    from .pipeline.map import MAX_WALL_FOLLOW_WEIGHT
 
     if not (math.isfinite(value) and 0 <= value <= MAX_WALL_FOLLOW_WEIGHT):
         raise typer.BadParameter(f"{text!r} must be a number in [0, {MAX_WALL_FOLLOW_WEIGHT:g}]")
@@ -443,10 +443,10 @@ def map_command(
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
     """Map an encounter log folder: Betti numbers with confidence, diagrams and pictures."""
-    from .classify import load_classifier
-    from .io import read_log
+    from .readers.paper import load_classifier
+    from .io.logs import read_log
     from .log import exact_time
-    from .pipeline import MapConfig, max_windows_option, seconds_option, wall_follow_option
+    from .pipeline.map import MapConfig, max_windows_option, seconds_option, wall_follow_option
 
     _check_verbosity(quiet, verbose)
     if paper:
@@ -499,8 +499,8 @@ def demo(
     Betti numbers beside the true ones and where the figures were written.
     """
     from .arena import default_arena
-    from .io import log_files, write_log
-    from .pipeline import MapConfig
+    from .io.logs import log_files, write_log
+    from .pipeline.map import MapConfig
     from .sim import simulate as run
 
     _check_verbosity(quiet, verbose)
@@ -527,7 +527,7 @@ def demo(
 
 def _demo_wrote(log_dir: Path) -> bool:
     """Whether ``log_dir``'s meta.json says ``swarmtopo demo`` wrote the log (so it may replace it)."""
-    from .io import read_json
+    from .io.logs import read_json
 
     meta = log_dir / "meta.json"
     try:
@@ -684,8 +684,8 @@ def bench_accuracy(
     import time
 
     from .experiments.accuracy import PLANNING_PER_CELL, markdown, run_benchmark
-    from .io import make_folder, write_json
-    from .plan import fit_plan
+    from .io.logs import make_folder, write_json
+    from .experiments.plan import fit_plan
 
     _check_verbosity(quiet, verbose)
     make_folder(out_dir)  # before the hour of maps, not after
@@ -717,7 +717,7 @@ def bench_accuracy(
 
 
 def _plan_input_option(value: str) -> str:
-    from .plan import SHIPPED_PLANS
+    from .experiments.plan import SHIPPED_PLANS
 
     if value not in SHIPPED_PLANS:
         raise typer.BadParameter(f"{value!r} is not one of {', '.join(map(repr, SHIPPED_PLANS))}")
@@ -750,8 +750,8 @@ def plan(
     if the swarm will record encounters only.  Answers come from the accuracy benchmark
     (docs/accuracy.md).
     """
-    from .pipeline import MIN_REGION_AGENTS
-    from .plan import load_plan
+    from .pipeline.map import MIN_REGION_AGENTS
+    from .experiments.plan import load_plan
 
     if agents is not None and agents < MIN_REGION_AGENTS:
         raise typer.BadParameter(f"a map needs encounters among {MIN_REGION_AGENTS} agents or more", param_hint="--agents")
@@ -800,8 +800,8 @@ def _run_map(log, config, log_dir: Path, out_dir: Path, quiet: bool, verbose: bo
     """Map, write map.json and figures; ground truth beside the log only colours pictures,
     and a broken ground-truth file costs a warning, never the map.  ``ground_truth``
     (arena, truth, trajectories): the caller's, instead of reading them beside the log."""
-    from .pipeline import STAGES, map_encounters
-    from .report import write_map_outputs
+    from .pipeline.map import STAGES, map_encounters
+    from .viz.report import write_map_outputs
 
     with _progress("mapping", quiet) as tick:
         try:
@@ -844,7 +844,7 @@ def _map_details(tmap) -> None:
 def _ground_truth(log, log_dir: Path, quiet: bool):
     """(arena, truth, trajectories) beside the log, each None when absent or broken
     (a broken file costs a warning: ground truth only draws pictures)."""
-    from .io import read_arena, read_trajectories, read_truth
+    from .io.logs import read_arena, read_trajectories, read_truth
 
     arena = truth = trajectories = None
     try:

@@ -35,11 +35,11 @@ import numpy as np
 from scipy.stats import bootstrap
 
 from ..arena import HOLE_SHAPES, OUTER_SHAPES
-from ..cycles import wilson_interval
+from ..topology.cycles import wilson_interval
 from ..errors import SwarmtopoError
-from ..persistence import Diagram
-from ..ratio import map_confidence, region_reader, vote
-from ..pipeline import MapConfig
+from ..topology.persistence import Diagram
+from ..readers.ratio import map_confidence, region_reader, vote
+from ..pipeline.map import MapConfig
 from .grid import Job, canonical_json, case_streams
 from .sweep import build_arena
 
@@ -105,7 +105,7 @@ PLANNING_PER_CELL = 3
 CALIBRATION_PER_CELL = 3
 """Cases per cell of the calibration grid: the planning grid's cells with seeds of their
 own (split "calibration"), on which the confidence is fitted besides the tuning maps
-(``scripts/tune_accuracy.py``), so that it holds for swarms and logs beyond the suite's
+(``lab/tune_accuracy.py``), so that it holds for swarms and logs beyond the suite's
 budgets; the planning grid then checks it on cases it was not fitted on."""
 
 _session = {"tuning": False}
@@ -172,7 +172,7 @@ def built_case(cell: Cell, split: str, index: int):
 def tuning_arena(cell: Cell, index: int):
     """:func:`built_case` of tuning case ``index`` of ``cell``, opened inside
     :func:`tuning_session` (the benchmark scripts that simulate tuning cases themselves:
-    ``benchmarks/levers.py`` and others)."""
+    ``lab/levers.py`` and others)."""
     with tuning_session():
         return built_case(cell, "tuning", index)
 
@@ -286,7 +286,7 @@ def outcomes(rows, classifier, cells=CELLS) -> list[dict[str, Any]]:
     if the classifier gates by agreement), so the table is
     the given classifier's verdict on the stored maps: the shipped one's, whatever
     classifier ran the job.  beta_0 and its confidence are the job's (graph components,
-    :mod:`swarmtopo.beta0`).  A failed job
+    :mod:`swarmtopo.readers.beta0`).  A failed job
     (too little data to map) counts as wrong.
     """
     records = []
@@ -425,7 +425,7 @@ def run_benchmark(store, *, quick: bool = False, scheduler: str | None = None, w
     Each pipeline's maps are read by its shipped classifier (:func:`outcomes`);
     ``paper-theta`` is the paper pipeline's maps read by the paper's published Theta*.
     """
-    from ..classify import load_classifier
+    from ..readers.paper import load_classifier
     from .store import job_rows_each
     from .sweep import run_sweep
 

@@ -21,8 +21,8 @@ from typing import Any, Callable
 import numpy as np
 
 from .._validate import positive_int
-from ..classify import detection_scores, paper_classifier
-from ..persistence import Diagram
+from ..readers.paper import detection_scores, paper_classifier
+from ..topology.persistence import Diagram
 from .grid import expand_grid
 from .store import read_jobs
 from .sweep import build_arena, run_sweep
@@ -54,7 +54,7 @@ def reproduce_clust(out: Path, *, runs: int | None = None, progress: Callable[[i
                     store: Path | None = None, workers: int | None = None, scheduler: str | None = None):
     """Run the sweeps, fit, test, and write ``clust.csv`` and the figures into ``out``."""
     from .reproduce import output_folder, write_reproduction
-    from ..plotting import plot_arena, plot_diagram, new_figure, plot_ratio_density, plot_scores_by
+    from ..viz.plots import plot_arena, plot_diagram, new_figure, plot_ratio_density, plot_scores_by
 
     runs = RUNS if runs is None else positive_int("runs", runs)
     out = output_folder(out)

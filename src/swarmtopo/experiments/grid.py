@@ -84,12 +84,12 @@ from typing import Any, Callable
 import numpy as np
 
 from ..arena import HOLE_SHAPES, OUTER_SHAPES
-from ..classify import PRESETS, load_classifier
+from ..readers.paper import PRESETS, load_classifier
 from ..errors import InputError, SwarmtopoError
-from ..graph import METRICS
-from ..io import read_arena
-from ..landmarks import SUBSAMPLERS
-from ..pipeline import MapConfig, seconds_option, wall_follow_option
+from ..metric.graph import METRICS
+from ..io.logs import read_arena
+from ..metric.landmarks import SUBSAMPLERS
+from ..pipeline.map import MapConfig, seconds_option, wall_follow_option
 from ..sim.simulate import check_parameters
 
 GENERATORS: dict[str, tuple[str, ...]] = {

@@ -48,15 +48,15 @@ from scipy.stats import spearmanr
 
 from .._validate import positive_int
 from ..arena import Arena, annulus_arena, default_arena
-from ..classify import load_classifier
-from ..cycles import event_positions
-from ..embed import mds
+from ..readers.paper import load_classifier
+from ..topology.cycles import event_positions
+from ..topology.embed import mds
 from ..errors import InputError, SwarmtopoError
-from ..graph import build_graph
-from ..io import jsonable, write_json
-from ..landmarks import knn_maxmin, maxmin, probabilistic_maxmin
-from ..persistence import Diagram, rips_persistence, snr
-from ..pipeline import WHOLE_LOG, MapConfig, TopologicalMap, map_encounters, software_versions
+from ..metric.graph import build_graph
+from ..io.logs import jsonable, write_json
+from ..metric.landmarks import knn_maxmin, maxmin, probabilistic_maxmin
+from ..topology.persistence import Diagram, rips_persistence, snr
+from ..pipeline.map import WHOLE_LOG, MapConfig, TopologicalMap, map_encounters, software_versions
 from ..sim import simulate
 from .clust import reproduce_clust
 
@@ -87,7 +87,7 @@ KNN_K = 10
 KNN_Q = 0.9
 OMEGA = 1.0
 """land2's subsampler parameters (paper: 150 landmarks, k = 10, q = 0.9; omega is the
-project's unit-free weight, :func:`swarmtopo.landmarks.probabilistic_maxmin`)."""
+project's unit-free weight, :func:`swarmtopo.metric.landmarks.probabilistic_maxmin`)."""
 DEFAULT_RUNS = {"enc": 50, "encmds": 50, "encimpr": 10, "land2": 100}
 """Runs (seeds, or subsamplings for land2) of the full experiments (land2: paper's 100)."""
 SAME_PLACE_MM = 30.0
@@ -341,7 +341,7 @@ ENCIMPR_CONDITIONS = (("plain", 0.0), ("contracted", 0.0), ("hybrid", STATIC_FRA
 """(metric, static fraction of the log) compared by encimpr: the paper's mobile network
 with its encounter metric, the contracted metric on the same log (natural stops only),
 and the contracted metric of the hybrid network (5 % static agents), which is what
-``hybrid`` computes (see :mod:`swarmtopo.graph`)."""
+``hybrid`` computes (see :mod:`swarmtopo.metric.graph`)."""
 
 
 def reproduce_encimpr(out: Path, *, runs: int | None = None, progress: Progress | None = None) -> Reproduction:
@@ -635,7 +635,7 @@ DPI = 100
 
 
 def _enc_figure(path: Path, arena: Arena, sim, tmap: TopologicalMap, xy, angle, concordance: float, seed: int) -> Path:
-    from ..plotting import cyclic_colors, new_figure, plot_arena, plot_diagram, plot_point_cloud
+    from ..viz.plots import cyclic_colors, new_figure, plot_arena, plot_diagram, plot_point_cloud
 
     region = tmap.regions[0]
     coords, times, colours = region.embedding.coords, sim.log.t[region.landmark_events], cyclic_colors(angle)
@@ -653,7 +653,7 @@ def _enc_figure(path: Path, arena: Arena, sim, tmap: TopologicalMap, xy, angle, 
 
 
 def _encmds_figure(path: Path, arena: Arena, sim, tmap: TopologicalMap) -> Path:
-    from ..plotting import new_figure, plot_arena, plot_diagram, plot_point_cloud
+    from ..viz.plots import new_figure, plot_arena, plot_diagram, plot_point_cloud
 
     region = tmap.regions[0]
     events = region.landmark_events
@@ -670,7 +670,7 @@ def _encmds_figure(path: Path, arena: Arena, sim, tmap: TopologicalMap) -> Path:
 
 
 def _encimpr_figure(path: Path, pictures: dict[str, tuple]) -> Path:
-    from ..plotting import new_figure, plot_diagram, plot_point_cloud
+    from ..viz.plots import new_figure, plot_diagram, plot_point_cloud
 
     fig = new_figure(4.8 * len(pictures), 8.8)
     for col, (metric, (sim, tmap)) in enumerate(pictures.items(), start=1):
@@ -687,7 +687,7 @@ def _encimpr_figure(path: Path, pictures: dict[str, tuple]) -> Path:
 
 
 def _separation_figure(path: Path, rows, durations: list, titles: list[str], *, by_metric: bool = False) -> Path:
-    from ..plotting import new_figure, plot_bar_separation
+    from ..viz.plots import new_figure, plot_bar_separation
 
     fig = new_figure(5.2 * len(durations), 4.8)
     for col, (duration, title) in enumerate(zip(durations, titles), start=1):
@@ -701,7 +701,7 @@ def _separation_figure(path: Path, rows, durations: list, titles: list[str], *, 
 
 
 def _land2_figure(path: Path, first: dict[str, tuple], node_times: np.ndarray, snrs: dict[str, np.ndarray]) -> Path:
-    from ..plotting import new_figure, plot_diagram, plot_distributions, plot_point_cloud
+    from ..viz.plots import new_figure, plot_diagram, plot_distributions, plot_point_cloud
 
     fig = new_figure(16, 8)
     grid = fig.add_gridspec(2, len(first) + 1, width_ratios=[1] * len(first) + [0.8])

@@ -32,12 +32,12 @@ from functools import lru_cache
 from typing import Any, Callable, Iterable
 
 from ..arena import Arena, annulus_arena, default_arena, random_arena, square_arena, two_rooms_arena
-from ..classify import PRESETS, BettiClassifier, load_classifier
+from ..readers.paper import PRESETS, BettiClassifier, load_classifier
 from ..errors import SwarmtopoError
-from ..io import GROUND_TRUTH_META_KEYS, read_arena, read_log, write_log
+from ..io.logs import GROUND_TRUTH_META_KEYS, read_arena, read_log, write_log
 from ..log import EncounterLog
-from ..persistence import snr
-from ..pipeline import agreement_json, map_encounters, software_versions
+from ..topology.persistence import snr
+from ..pipeline.map import agreement_json, map_encounters, software_versions
 from ..sim import simulate
 from .grid import Job, flat_columns, job_map_config, job_simulation_args
 from .store import JOB_COLUMNS, ResultStore
@@ -84,8 +84,8 @@ def stripped_log(log: EncounterLog) -> EncounterLog:
     """The log as ``swarmtopo map`` reads it from a folder stripped of ground truth.
 
     Written to a temporary folder without truth, trajectories, arena or
-    ``GROUND_TRUTH_META_KEYS`` (as :func:`~swarmtopo.io.strip_ground_truth` leaves a
-    folder), and read back with :func:`~swarmtopo.io.read_log`: the map of a sweep sees
+    ``GROUND_TRUTH_META_KEYS`` (as :func:`~swarmtopo.io.logs.strip_ground_truth` leaves a
+    folder), and read back with :func:`~swarmtopo.io.logs.read_log`: the map of a sweep sees
     exactly what a user's ``map`` of such a folder would.
     """
     meta = {k: v for k, v in log.meta.items() if k not in GROUND_TRUTH_META_KEYS}
@@ -125,7 +125,7 @@ def map_input(mapping: dict[str, Any]) -> str:
 
 def job_classifier(mapping: dict[str, Any]) -> str:
     """The classifier a job's map is read with: its ``[map]`` table's, "default" being
-    ``map``'s own for what the job reads (:func:`~swarmtopo.pipeline.shipped_classifier_for`:
+    ``map``'s own for what the job reads (:func:`~swarmtopo.pipeline.map.shipped_classifier_for`:
     ``trace`` for a contact trace; a simulated log always has status rows)."""
     name = mapping["classifier"]
     return "trace" if name == "default" and map_input(mapping) == "contact-trace" else name

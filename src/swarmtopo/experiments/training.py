@@ -8,7 +8,7 @@ map are examples; a map whose largest region is one of several is still an examp
 :func:`fit_and_select` fits Theta_1 with both optimizers on the training maps, scores
 both on held-out maps (never on the training F), keeps the better one (lower held-out
 F; the grid optimizer on a tie, being exact and deterministic) and calibrates its
-confidence on the held-out maps.  ``scripts/train_classifier.py`` runs it on
+confidence on the held-out maps.  ``lab/train_classifier.py`` runs it on
 :data:`DEFAULT_TRAINING` to make the shipped ``classifier-default.json``.
 """
 
@@ -20,8 +20,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..classify import BettiClassifier, DetectionScores, detection_scores
-from ..persistence import Diagram
+from ..readers.paper import BettiClassifier, DetectionScores, detection_scores
+from ..topology.persistence import Diagram
 
 DEFAULT_TRAINING: dict[str, Any] = {
     "sweep": {"name": "classifier-train", "salt": "classifier-train", "replicates": 2},

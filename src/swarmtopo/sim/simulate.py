@@ -30,7 +30,7 @@ from .. import __version__
 from .._validate import fraction, non_negative, positive, positive_int
 from ..arena import Arena
 from ..errors import InputError
-from ..io import LOG_FORMAT, jsonable
+from ..io.logs import LOG_FORMAT, jsonable
 from ..log import EncounterLog, state_labels
 from . import commands as _commands
 from . import motion as _motion
@@ -123,7 +123,7 @@ def simulate(
     Returns
     -------
     Simulation
-        ``log.meta`` holds ``format`` (:data:`swarmtopo.io.LOG_FORMAT`), ``version``,
+        ``log.meta`` holds ``format`` (:data:`swarmtopo.io.logs.LOG_FORMAT`), ``version``,
         ``units``, r_d, v_c, v_p, ``duration`` (t_K), dt, ``agent_count``, ``seed``
         and ``simulation`` (all parameters; infinities written as ``"inf"``).
 
