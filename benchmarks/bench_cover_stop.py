@@ -25,9 +25,9 @@ from _data import simulated_log
 from _measure import machine, revision
 from swarmtopo.pipeline import map as pipeline
 from swarmtopo.metric.landmarks import covering_prefix
-from swarmtopo.pipeline.map import MapConfig, map_encounters
+from swarmtopo.pipeline import MapConfig, map_encounters
 
-SHIPPED = pipeline._subsample
+SHIPPED = pipeline.subsample
 
 
 def cut_after(graph, config, n_landmarks, rng, candidates=None, cover=None):
@@ -37,13 +37,13 @@ def cut_after(graph, config, n_landmarks, rng, candidates=None, cover=None):
 
 
 def timed_map(log, baseline: bool):
-    pipeline._subsample = cut_after if baseline else SHIPPED
+    pipeline.subsample = cut_after if baseline else SHIPPED
     try:
         start = time.perf_counter()
         tmap = map_encounters(log, MapConfig(embed_dim=0, cycles=False))
         return tmap, time.perf_counter() - start
     finally:
-        pipeline._subsample = SHIPPED
+        pipeline.subsample = SHIPPED
 
 
 def fingerprint(tmap):

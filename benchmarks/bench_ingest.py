@@ -6,7 +6,7 @@ Two generated traces of ROWS lines (10^6, ``--quick``: 10^5):
   contacts of a geometric number of 20 s windows (mean 3), so merging has work;
 * CSV ``t,a,b`` with text IDs (``agent-17``), one encounter per row.
 
-For each: median wall time of 3 ingests (``swarmtopo.io.traces.ingest``, file to
+For each: median wall time of 3 ingests (``swarmtopo.io.read_trace``, file to
 EncounterLog), the peak RSS above the level before one more ingest (Arrow set to the
 system allocator, so freed memory is returned and shows in the next peak), and the same
 for the baseline measured in the same run: a plain ``pyarrow.csv.read_csv`` of the
@@ -34,7 +34,7 @@ import pyarrow as pa
 import pyarrow.csv as pcsv
 
 from _measure import machine, revision, run_measured
-from swarmtopo.io.traces import ingest
+from swarmtopo.io import read_trace
 
 REPEATS = 3
 BOUND_BYTES_PER_ROW = 400
@@ -107,7 +107,7 @@ def main() -> None:
                  ("csv", Path(tmp) / "events.csv", csv_trace, pcsv.ParseOptions(), pcsv.ReadOptions())]
         for fmt, path, make, parse, read in cases:
             make(path, rows, rng)
-            seconds, peak, (log, report) = measure(lambda: ingest(path, fmt))
+            seconds, peak, (log, report) = measure(lambda: read_trace(path, fmt))
             assert report.lines == rows and report.skipped == 0
             base_seconds, base_peak, _ = measure(
                 lambda: pcsv.read_csv(path, read_options=read, parse_options=parse))

@@ -40,7 +40,8 @@ from _measure import machine, revision, run_measured
 from bench_landmarks import compare_with_dense
 from swarmtopo.metric.graph import build_graph
 from swarmtopo.metric.landmarks import SUBSAMPLERS
-from swarmtopo.pipeline.map import MapConfig, map_encounters, max_windows_option
+from swarmtopo.pipeline import MapConfig, map_encounters
+from swarmtopo.pipeline.map import max_windows_option
 
 N_LANDMARKS = 500
 METRICS = ("plain", "hybrid")

@@ -20,7 +20,8 @@ from shapely.geometry import MultiPolygon
 
 from swarmtopo.arena import Arena, two_rooms_arena
 from swarmtopo.readers.beta0 import shipped_beta0_model
-from swarmtopo.pipeline.map import MapConfig, split_regions
+from swarmtopo.pipeline import MapConfig
+from swarmtopo.pipeline.regions import split_regions
 from swarmtopo.sim import simulate
 
 CASES = {

@@ -36,7 +36,8 @@ from swarmtopo.experiments.accuracy import (CELLS, REPORTING_PER_CELL, SUITE, TU
                                             tuning_arena)
 from swarmtopo.experiments.sweep import stripped_log
 from swarmtopo.io.logs import write_json
-from swarmtopo.pipeline.map import MapConfig, split_regions
+from swarmtopo.pipeline import MapConfig
+from swarmtopo.pipeline.regions import split_regions
 from swarmtopo.sim import simulate
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -13,17 +13,15 @@ shuffled with seed 0: the maps are listed tuning first, grid last), and prints t
 and log loss of those predictions, on the tuning maps and on the grid apart, with each
 one's reliability table in the bins of the accuracy benchmark.
 
-These are the default (score-only) classifier's maps, or with ``--reading contact-trace``
+These are the default classifier's maps, or with ``--reading contact-trace``
 the ``trace`` classifier's (the same cases and grid read as contact traces, thresholds
-fitted on those maps); the ``gated`` preset's confidence
-is fitted on its own tuning maps by ``lab/fit_agreement_gate.py`` (the shipped file on z).
+fitted on those maps).
 
 Feature sets: ``z`` (how many standard errors the pooled scores are from changing the
 vote, ``ratio.standardised_margin``); z and the windows' resolution ln L
 (``ratio.resolution``); those and z ln L (shipped); those and ln #windows; those and the
 region's span ln T (the seconds its windows cover, ``ratio.windows_span``); those and z
-ln T (measured, not adopted: docs/accuracy.md); the calibration before z (agreement of
-the windows with the vote, log margin, ln #windows).
+ln T (measured, not adopted: docs/accuracy.md).
 Each is fitted on both sets; then how often a draw of the reporting suite's size
 (390 maps) from the tuning maps shows the shipped features no better than the constant;
 last, z fitted on the tuning maps alone, as before the grid.  With ``--planning-store``
@@ -52,7 +50,7 @@ from swarmtopo.experiments.store import read_jobs
 from swarmtopo.experiments.sweep import INPUTS, map_input
 from tuning import (cross_fitted_features, features_under, fit_thresholds, job_pipeline,
                                          maps_from_rows, pipeline_fields)
-from swarmtopo.pipeline.map import MapConfig
+from swarmtopo.pipeline import MapConfig
 from swarmtopo.readers.ratio import CONFIDENCE_FEATURES, SPAN_FEATURES, confidence_design, confidence_model
 
 FEATURE_SETS = {
@@ -62,7 +60,6 @@ FEATURE_SETS = {
     "z, resolution, z x resolution, ln windows": (*CONFIDENCE_FEATURES, "windows"),
     "z, resolution, z x resolution, ln span": (*CONFIDENCE_FEATURES, "log_span"),
     "z, resolution, z x resolution, ln span, z x ln span": (*CONFIDENCE_FEATURES, *SPAN_FEATURES),
-    "agreement, margin, ln windows (before z)": ("agreement", "margin", "windows"),
 }
 COLUMNS = ("key", "sweep", "config", "replicate", "diagrams", "error", "est_betti0", "true_betti0", "true_betti1")
 

@@ -22,7 +22,7 @@ from swarmtopo.arena import random_arena
 from swarmtopo.topology.cycles import (DEFAULT_POSITION, encircled_obstacles, event_positions, localization_scores,
                               representative_cycles, wilson_interval)
 from swarmtopo.topology.persistence import rips_persistence
-from swarmtopo.pipeline.map import MapConfig, map_encounters
+from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.viz.plots import new_figure, plot_cycles
 from swarmtopo.sim import simulate
 

@@ -4,8 +4,8 @@
 shorter than an automatic window of 20 encounters per agent, so the default's window
 scales 1 and 1.25 map the log whole and scale 0.75 gives two windows) and 30 s (the demo).
 Prints how many maps give the exact beta_1 over seeds 0..N-1 for swarmtopo's default
-pipeline and for the paper's (``swarmtopo map --paper``: no per-hop cost, the
-paper's Theta*) and its classifier form trained our way (``paper-form``).  These
+pipeline and for the paper's (``swarmtopo map --paper``: no per-hop cost, the whole
+log, the paper's classifier form, the ``paper`` preset).  These
 fixed arenas are in neither the tuning nor the training cases.
 
     python lab/demo_accuracy.py [--seeds N]
@@ -15,14 +15,14 @@ import argparse
 
 from swarmtopo.arena import default_arena, square_arena
 from swarmtopo.readers.paper import load_classifier
-from swarmtopo.pipeline.map import WHOLE_LOG, MapConfig, map_encounters
+from swarmtopo.pipeline.config import WHOLE_LOG
+from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.sim import simulate
 
 PAPER_WEIGHTS = dict(hop_cost=0.0, diffusion_time=WHOLE_LOG, wall_follow_weight=None, window_length=WHOLE_LOG)
 PIPELINES = {
     "default": (dict(), "default"),
-    "paper form (h = 0, whole log)": (PAPER_WEIGHTS, "paper-form"),
-    "--paper (h = 0, whole log, Theta*)": (PAPER_WEIGHTS, "paper"),
+    "--paper (h = 0, whole log)": (PAPER_WEIGHTS, "paper"),
 }
 
 

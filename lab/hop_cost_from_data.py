@@ -16,7 +16,7 @@ import numpy as np
 from swarmtopo.arena import HOLE_SHAPES, OUTER_SHAPES, random_arena
 from swarmtopo.experiments.accuracy import BUDGETS, SCALE_RANGE
 from swarmtopo.log import EncounterLog
-from swarmtopo.pipeline.map import resolve_hop_cost
+from swarmtopo.pipeline.settings import hop_cost
 from swarmtopo.sim import simulate
 
 
@@ -33,9 +33,9 @@ def main() -> None:
             arena = random_arena(int(rng.integers(0, 4)), scale=rng.uniform(*SCALE_RANGE), shapes=HOLE_SHAPES,
                                  outer=OUTER_SHAPES[int(rng.integers(3))], rng=rng)
             log = simulate(arena, agents, duration, rng=rng).log
-            reference.append(resolve_hop_cost(log, None)[0])
+            reference.append(hop_cost(log, None)[0])
             bare = EncounterLog.from_records(log.t, log.a, log.b)  # a trace: no meta.json
-            from_data.append(resolve_hop_cost(bare, None)[0])
+            from_data.append(hop_cost(bare, None)[0])
         h = np.array(from_data)
         ratio = np.median(h / np.array(reference))
         print(f"| {agents} x {duration:g} | {np.median(reference):.2f} | {np.median(h):.2f} [{h.min():.2f}, {h.max():.2f}] "

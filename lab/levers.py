@@ -130,13 +130,19 @@ from swarmtopo.metric import graph as G
 from swarmtopo.metric import landmarks as L
 from swarmtopo.pipeline import map as P
 from swarmtopo.topology.embed import mds
-from swarmtopo.readers.paper import load_classifier
+from swarmtopo.readers.registry import load_classifier
 from swarmtopo.errors import SwarmtopoError
 from swarmtopo.experiments.accuracy import CELLS, tuning_arena
 from swarmtopo.experiments.sweep import contact_trace, stripped_log
 from tuning import TuningMap, cross_validated, exact, fit_thresholds
-from swarmtopo.topology.persistence import Diagram, rips_persistence
-from swarmtopo.pipeline.map import WHOLE_LOG, MapConfig, map_encounters, mean_agent_gap, resolve_window
+from swarmtopo.topology.persistence import Diagram, PersistenceResult, rips_persistence
+from swarmtopo.pipeline.config import WALL_FOLLOW_WEIGHT, WHOLE_LOG
+from swarmtopo.pipeline import MapConfig, config_from_options, map_encounters
+from swarmtopo.pipeline.result import RegionScales, WindowMap
+from swarmtopo.pipeline.settings import HOP_GAP_FACTOR, mean_agent_gap
+from swarmtopo.pipeline.settings import diffusion_time as diffusion_time_of
+from swarmtopo.pipeline.settings import hop_cost as hop_cost_of
+from swarmtopo.pipeline.windows import in_band, window_length
 from swarmtopo.readers.ratio import POOLINGS
 from swarmtopo.sim import simulate
 
@@ -151,7 +157,7 @@ def _windows_of(log, seed, **options):
 def _quarter(log, seed):
     config = MapConfig()
     span = float(log.t[-1] - log.t[0])
-    length, _ = resolve_window(mean_agent_gap(log), None, config.window_encounters, span)
+    length, _ = window_length(mean_agent_gap(log), None, config.window_encounters, span)
     return _windows_of(log, seed, window_step=length / 4 if np.isfinite(length) else None)
 
 
@@ -201,13 +207,30 @@ def _switch_graph(log, metric="plain", *, window=None, hop_cost=0.0, diffusion_t
     return G._contract(chains.t, np.concatenate(u), np.concatenate(v), np.concatenate(w), chains.event_index, metric)
 
 
-def _switch(log, seed, **options):
-    original = P.build_graph
-    P.build_graph = _switch_graph
+class _Rebuilt:
+    """A stand-in for the pipeline's ``WeightedChains`` whose graphs are each built anew by
+    ``build(log, metric, window=..., **options)``: the whole mapped log's and every
+    window's, so a variant can change how a window's graph is made."""
+
+    def __init__(self, build, log, metric, window, options):
+        self.build, self.log, self.metric, self.window, self.options = build, log, metric, window, options
+
+    def graph(self, span=None):
+        return self.build(self.log, self.metric, window=self.window if span is None else span, **self.options)
+
+
+def _with_graphs(build, log, seed, **options):
+    """Map with every graph built by ``build`` (a ``build_graph``-like function)."""
+    original = P.weighted_chains
+    P.weighted_chains = lambda log_, metric, *, window=None, **kw: _Rebuilt(build, log_, metric, window, kw)
     try:
-        return _windows_of(log, seed, wall_follow_weight=None, **options)
+        return _windows_of(log, seed, **options)
     finally:
-        P.build_graph = original
+        P.weighted_chains = original
+
+
+def _switch(log, seed, **options):
+    return _with_graphs(_switch_graph, log, seed, wall_follow_weight=None, **options)
 
 
 def _witness_filtration(to_nodes: np.ndarray) -> np.ndarray:
@@ -224,17 +247,17 @@ def _witness_filtration(to_nodes: np.ndarray) -> np.ndarray:
 def _other_persistence(log, seed, persistence_of):
     """Map with ``persistence_of(window, sub, maxdim)`` (a PersistenceResult from a
     window's landmarks and its graph) instead of Vietoris-Rips on the landmarks' metric."""
-    original = P._map_window
+    original = P.map_window
 
     def window_with_other_persistence(span, sub, knn_scale, n_land, config, rng, timings, say, band=1.0):
         window = original(span, sub, knn_scale, n_land, config, rng, timings, say, band)
         return dataclasses.replace(window, persistence=persistence_of(window, sub, config.maxdim))
 
-    P._map_window = window_with_other_persistence
+    P.map_window = window_with_other_persistence
     try:
         return _windows_of(log, seed)
     finally:
-        P._map_window = original
+        P.map_window = original
 
 
 def _other_filtration(log, seed, values_of):
@@ -295,10 +318,10 @@ def _hub_distances(log, window, hop_cost: float, diffusion_time: float, wall_fol
 
 
 def _hub(log, seed):
-    hop_cost = P.resolve_hop_cost(log, None)[0]
-    diffusion_time = P.resolve_diffusion_time(mean_agent_gap(log), None)[0]
+    hop_cost = hop_cost_of(log, None)[0]
+    diffusion_time = diffusion_time_of(mean_agent_gap(log), None)[0]
     return _other_filtration(log, seed, lambda window, sub: _hub_distances(
-        log, window, hop_cost, diffusion_time, P.WALL_FOLLOW_WEIGHT))
+        log, window, hop_cost, diffusion_time, WALL_FOLLOW_WEIGHT))
 
 
 def _time_corrected(distances: np.ndarray, times: np.ndarray, share: float) -> np.ndarray:
@@ -362,7 +385,7 @@ def _dtm_persistence(to_nodes: np.ndarray, distances: np.ndarray, k: int, maxdim
     np.fill_diagonal(values, f)
     out = ripser(sparse.coo_matrix(values), maxdim=maxdim, distance_matrix=True)
     pairs = [np.asarray(d, float).reshape(-1, 2) for d in out["dgms"]]
-    return P.PersistenceResult(Diagram(tuple(pairs), "ripser"), None, "ripser", 0.0)
+    return PersistenceResult(Diagram(tuple(pairs), "ripser"), None, "ripser", 0.0)
 
 
 def _dtm(log, seed, k):
@@ -395,24 +418,24 @@ def _trajectory(log, seed, factor):
     """Landmarks and Rips on the chain graph's edges cut every ``factor`` x the window's
     k-NN scale s (virtual points along the agents' paths); landmarks cover to 1.5 s as
     by default."""
-    original = P._map_window
+    original = P.map_window
 
     def window_on_paths(span, sub, knn_scale, n_land, config, rng, timings, say, band=1.0):
         assert band == 1.0, band
         dense = _subdivided(sub, factor * knn_scale)
-        land = P._subsample(dense, config, min(config.max_landmarks, dense.n_nodes), rng,
+        land = P.subsample(dense, config, min(config.max_landmarks, dense.n_nodes), rng,
                             cover=P.AUTO_COVER_FACTOR * knn_scale)
         persistence = rips_persistence(land.distances, maxdim=config.maxdim)
-        return P.WindowMap(t0=0.0, t1=0.0, n_events=sub.n_events, landmarks=land,
+        return WindowMap(t0=0.0, t1=0.0, n_events=sub.n_events, landmarks=land,
                            landmark_events=np.zeros(len(land.nodes), np.int64),
-                           scales=P.RegionScales(knn=knn_scale, cover_radius=float(land.cover_radius)),
+                           scales=RegionScales(knn=knn_scale, cover_radius=float(land.cover_radius)),
                            persistence=persistence)
 
-    P._map_window = window_on_paths
+    P.map_window = window_on_paths
     try:
         return _windows_of(log, seed, landmark_bands=(1.0,))
     finally:
-        P._map_window = original
+        P.map_window = original
 
 
 def _padded(log, seed, factor):
@@ -420,14 +443,14 @@ def _padded(log, seed, factor):
     sides, landmarks drawn only among the nodes inside the window (inside its landmark
     band, with bands): paths may leave the
     window in time, so the events at its edges are not outliers of a cut chain."""
-    original_build, original_map, original_subsample = P.build_graph, P._map_window, P._subsample
+    original_map, original_subsample = P.map_window, P.subsample
     current = {"span": None, "band": 1.0}
 
     def build(log_, metric, *, window=None, **options):
-        if window is not None:
+        if window is not None and None not in window:
             pad = factor * (window[1] - window[0])
             window = (window[0] - pad, window[1] + pad)
-        return original_build(log_, metric, window=window, **options)
+        return G.build_graph(log_, metric, window=window, **options)
 
     def map_window(span, sub, knn_scale, n_land, config, rng, timings, say, band=1.0):
         current["span"], current["band"] = span, band
@@ -437,13 +460,13 @@ def _padded(log, seed, factor):
         if current["span"] is None:
             return original_subsample(graph, config, n_landmarks, rng, candidates, cover)
         return L.maxmin(graph, n_landmarks, rng=rng, cover=cover,
-                        candidates=P.in_band(graph.node_times(), current["span"], current["band"]))
+                        candidates=in_band(graph.node_times(), current["span"], current["band"]))
 
-    P.build_graph, P._map_window, P._subsample = build, map_window, subsample
+    P.map_window, P.subsample = map_window, subsample
     try:
-        return _windows_of(log, seed)
+        return _with_graphs(build, log, seed)
     finally:
-        P.build_graph, P._map_window, P._subsample = original_build, original_map, original_subsample
+        P.map_window, P.subsample = original_map, original_subsample
 
 
 def config_override(text: str) -> dict:
@@ -495,7 +518,7 @@ def _variant(name):
     if name.startswith("seed+"):
         return lambda log, seed: _windows_of(log, seed + int(name.split("+", 1)[1]))
     if name.startswith("wall-"):
-        return lambda log, seed: _windows_of(log, seed, wall_follow_weight=P.wall_follow_option(name.split("-", 1)[1]))
+        return lambda log, seed: _windows_of(log, seed, wall_follow_weight=config_from_options({"wall_follow_weight": name.split("-", 1)[1]}).wall_follow_weight)
     if name.startswith("pad-"):
         return lambda log, seed: _padded(log, seed, float(name.split("-", 1)[1]))
     if name.startswith("band-"):
@@ -529,7 +552,7 @@ def _variant(name):
 
 
 def _hop_times(factor):
-    return lambda log, seed: _windows_of(log, seed, hop_cost=factor * P.resolve_hop_cost(log, None)[0])
+    return lambda log, seed: _windows_of(log, seed, hop_cost=factor * hop_cost_of(log, None)[0])
 
 
 def _covering(factor, inner):
@@ -559,7 +582,7 @@ VARIANTS = {
     "geodesic": _geodesic,
     "hop-half": _hop_times(0.5),
     "hop-double": _hop_times(2.0),
-    "hop-data": lambda log, seed: _windows_of(log, seed, hop_cost=P.HOP_GAP_FACTOR * mean_agent_gap(log)),
+    "hop-data": lambda log, seed: _windows_of(log, seed, hop_cost=HOP_GAP_FACTOR * mean_agent_gap(log)),
     "dense": _covering(1.0, lambda log, seed: _windows_of(log, seed, max_landmarks=800)),
     "mix": _window_mix,
     "hub": _hub,

@@ -22,7 +22,7 @@ import numpy as np
 
 from swarmtopo.experiments.accuracy import CELLS, tuning_arena
 from swarmtopo.experiments.sweep import stripped_log
-from swarmtopo.pipeline.map import MapConfig, map_encounters
+from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.sim import simulate
 
 BUDGET = "400 x 60 s"

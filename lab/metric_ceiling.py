@@ -53,7 +53,7 @@ from swarmtopo.experiments.accuracy import CELLS, tuning_arena
 from swarmtopo.experiments.sweep import stripped_log
 from tuning import TuningMap, cross_validated, exact, fit_thresholds
 from swarmtopo.topology.persistence import rips_persistence
-from swarmtopo.pipeline.map import MapConfig, map_encounters
+from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.sim import simulate
 
 TIME_DRIFT_MM_PER_S = (2.8,)
@@ -122,12 +122,12 @@ def _window_readings(arena, log, truth, window, region_count: int, rng: np.rando
 def _windows(log, seed, subsample=None):
     """The default map of ``log`` (every window), with ``subsample`` in place of the
     pipeline's subsampler if given."""
-    original = P._subsample
-    P._subsample = subsample or original
+    original = P.subsample
+    P.subsample = subsample or original
     try:
         return map_encounters(log, MapConfig(seed=seed, embed_dim=0, cycles=False, max_windows=None))
     finally:
-        P._subsample = original
+        P.subsample = original
 
 
 def _run(task):

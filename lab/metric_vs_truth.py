@@ -23,7 +23,7 @@ from scipy.spatial import cKDTree
 from swarmtopo.topology.cycles import event_positions
 from swarmtopo.experiments.accuracy import CELLS, tuning_arena
 from swarmtopo.experiments.sweep import stripped_log
-from swarmtopo.pipeline.map import MapConfig, map_encounters
+from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.sim import simulate
 
 GRID_MM = 5.0

@@ -25,7 +25,7 @@ regimes' maps (Brier score against a constant, and its bins).
 ``--first`` is the index of the first case of each regime (``--first 12`` the next
 twelve); ``--set`` maps with ``MapConfig`` fields changed (as
 ``lab/levers.py``'s ``FIELD=VALUE`` variants: ``--set window_encounters=40``);
-``--classifier`` reads every map with a preset (``gated``) or a classifier file instead of
+``--classifier`` reads every map with a preset (``paper``) or a classifier file instead of
 the one ``map`` picks (its landmark bands too, when ``--set`` leaves them unset);
 ``--contact-trace`` maps each log's encounters only, as a real contact trace comes
 (``experiments.sweep.contact_trace``: no status, no r_d or speeds; ``map`` then reads it
@@ -51,7 +51,7 @@ from swarmtopo.arena import HOLE_SHAPES, OUTER_SHAPES, random_arena
 from swarmtopo.errors import SwarmtopoError
 from swarmtopo.experiments.accuracy import ROOM_SIDE, Rate, reliability, reliability_bin_lines
 from swarmtopo.experiments.sweep import cached_classifier, contact_trace, stripped_log
-from swarmtopo.pipeline.map import MapConfig, map_encounters
+from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.experiments.plan import load_plan
 from swarmtopo.readers.ratio import RatioClassifier, pooled_scores
 from swarmtopo.sim import MotionParams, SensingParams, simulate

@@ -86,7 +86,7 @@ def _classifier(name: str):
     """A preset or JSON file (``load_classifier``), or ``ratio:POOLING:Q:TAU``."""
     if name.startswith("ratio:"):
         _, pooling, q, tau = name.split(":")
-        return RatioClassifier({1: RatioThresholds(float(q), float(tau))}, pooling=pooling)
+        return RatioClassifier.from_thresholds({1: RatioThresholds(float(q), float(tau))}, pooling=pooling)
     return load_classifier(name)
 
 

@@ -12,14 +12,13 @@ writes
   candidate and pooling, its confidence calibrated on the tuning maps (cross-fitted)
   and on the calibration grid (``experiments.accuracy.calibration_jobs``: the planning
   grid's swarm sizes, durations and arenas with seeds of their own, mapped by the
-  default pipeline), so that it holds beyond the suite's budgets (the ``gated``
-  classifier, ``lab/fit_agreement_gate.py``, starts from its q_1 and tau_1);
+  default pipeline), so that it holds beyond the suite's budgets;
 * ``src/swarmtopo/data/classifier-trace.json``: the same for ``CHOSEN_TRACE``, the
   chosen pipeline reading the tuning cases as contact traces (encounters only), which
   ``map`` uses for a log without status changes; its confidence is calibrated on the
   calibration grid read as contact traces too;
 * ``docs/tuning.md``: every candidate's tuning accuracy (ratio classifier and the
-  paper-form classifier), so what did not help is on record.
+  ``paper`` classifier), so what did not help is on record.
 
 The chosen candidate is declared, not the highest count of this run: each job's maps
 come from one landmark draw (its seed derives from the job), and on the sparsest cells
@@ -54,16 +53,16 @@ from pathlib import Path
 import numpy as np
 
 from swarmtopo import __version__
-from swarmtopo.readers.paper import load_classifier
+from swarmtopo.readers.registry import load_classifier
 from swarmtopo.experiments.accuracy import (CELLS, HELD_OUT_FAMILY, PLANNING_CELLS, SUITE, TUNING_PER_CELL, calibration_jobs,
                                            cell_of, tuning_jobs, tuning_session)
 from swarmtopo.experiments.store import job_rows
 from swarmtopo.experiments.sweep import job_map_config, map_input, run_sweep
-from tuning import (PIPELINE_FIELDS, Q_GRID, TAU_GRID, calibrated_classifier, cross_validated, exact,
-                                         fit_regions_exponent, fit_thresholds, maps_from_rows, regions_exponent_scores,
-                                         several_region_products, with_regions_exponent)
-from swarmtopo.pipeline.map import MapConfig
-from swarmtopo.readers.ratio import POOLINGS, REGIONS_EXPONENT, confidence_readout
+from tuning import (PIPELINE_FIELDS, calibrated_classifier, cross_validated, exact, fit_regions_exponent,
+                    fit_thresholds, maps_from_rows, regions_exponent_scores, several_region_products,
+                    with_regions_exponent)
+from swarmtopo.pipeline import MapConfig
+from swarmtopo.readers.ratio import POOLINGS, Q_GRID, REGIONS_EXPONENT, TAU_GRID, confidence_readout
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -148,7 +147,7 @@ def main() -> None:
         results = {}
         for name, candidate_rows in rows.items():
             maps = maps_from_rows(candidate_rows, cell_of)
-            paper_form = [r["error"] is None and r["est_betti0"] == r["true_betti0"]
+            paper = [r["error"] is None and r["est_betti0"] == r["true_betti0"]
                           and r["est_betti1"] == r["true_betti1"] for r in candidate_rows]
             for pooling in [SHIPPED[n][1] for n in shipping if SHIPPED[n][0] == name] if calibrate_only else POOLINGS:
                 fit = fit_thresholds(maps, pooling)
@@ -158,11 +157,11 @@ def main() -> None:
                 results[(name, pooling)] = {
                     "fit": fit, "maps": maps, "right": int(right.sum()), "cv": cv, "total": len(candidate_rows),
                     "failed": len(candidate_rows) - len(maps), "per_cell": per_cell,
-                    "paper_form": int(sum(paper_form)),
+                    "paper": int(sum(paper)),
                     "seconds": float(np.mean([r["t_total"] for r in candidate_rows]))}
                 cv_text = "" if cv is None else f" ({CV_FOLDS}-fold CV {cv})"
                 print(f"{name}, {pooling} pooling: {fit.thresholds}: {right.sum()}/{len(candidate_rows)}{cv_text}; "
-                      f"paper form {sum(paper_form)}/{len(candidate_rows)}")
+                      f"paper classifier {sum(paper)}/{len(candidate_rows)}")
     defaults, chosen_config = MapConfig(), job_map_config(jobs[SHIPPED[shipping[0]][0]][0].config["map"])
     # landmark_bands None: the bands the shipped classifier was fitted with, which this script writes
     resolved = {"landmark_bands": chosen_config.landmark_bands} if defaults.landmark_bands is None else {}
@@ -234,8 +233,8 @@ def _refit_regions_exponent(args) -> None:
 
 
 def _candidate_pipeline(name: str) -> dict:
-    """The job pipeline of candidate ``name`` (CANDIDATES): hybrid metric, paper-form stored readings."""
-    return {"metric": "hybrid", "classifier": "paper-form", **CANDIDATES[name]}
+    """The job pipeline of candidate ``name`` (CANDIDATES): hybrid metric, the ``paper`` classifier's readings."""
+    return {"metric": "hybrid", "classifier": "paper", **CANDIDATES[name]}
 
 
 def _print_regions_scores(name: str, log_products, right, model) -> None:
@@ -271,14 +270,14 @@ def _write_doc(results, chosen, args, seconds, summary, job_minutes, transfer) -
         f"(q_1, tau_1) is fitted on that candidate's maps, q in {list(Q_GRID)} x {len(TAU_GRID)} tau from "
         f"{TAU_GRID[0]} to {TAU_GRID[-1]}, at the best grid point after averaging each with its two tau "
         f"neighbours; the {CV_FOLDS}-fold column refits the thresholds without each fold and counts the fold's "
-        "maps. The paper-form column is the same maps read by the paper's classifier form trained our way "
-        "(`paper-form` preset), windows voted by the lower median. The chosen row is declared in the script "
+        "maps. The paper column is the same maps read by the paper's classifier form trained the paper's way "
+        "(`paper` preset), windows voted by the lower median. The chosen row is declared in the script "
         "(`CHOSEN`), not this run's highest count: each map here is one landmark draw, and the choice was made "
         "on tuning cases over three draws each (docs/accuracy.md). The same pipeline reading the cases as contact "
         "traces (`CHOSEN_TRACE`: encounters only, so h from the data and no wall following) gives the classifier "
         "of logs without status changes (`trace`).",
         "",
-        "| candidate | pooling | q_1 | tau_1 | exact | exact, 4-fold cross-validated | exact, paper form "
+        "| candidate | pooling | q_1 | tau_1 | exact | exact, 4-fold cross-validated | exact, paper classifier "
         "| worst cell | s per map |",
         "|---|---|---|---|---|---|---|---|---|",
     ]
@@ -290,7 +289,7 @@ def _write_doc(results, chosen, args, seconds, summary, job_minutes, transfer) -
         th = r["fit"].thresholds
         lines.append(f"| {key[0]}{mark} | {key[1]} | {th.q:g} | {th.tau:g} | {r['right']}/{r['total']} = "
                      f"{r['right'] / r['total']:.2f} | {r['cv']}/{r['total']} = {r['cv'] / r['total']:.2f} | "
-                     f"{r['paper_form']}/{r['total']} = {r['paper_form'] / r['total']:.2f} | "
+                     f"{r['paper']}/{r['total']} = {r['paper'] / r['total']:.2f} | "
                      f"{worst[0]}: {worst[1][0]}/{worst[1][1]} | {r['seconds']:.2f} |")
     th, right, total = transfer
     lines += ["", f"The contact-trace candidate's maps read with the default's thresholds (q_1 = {th.q:g}, "

@@ -1,23 +1,20 @@
 """Choosing the default pipeline and ratio classifier on the benchmark's tuning cases.
 
 ``lab/tune_accuracy.py`` runs the tuning jobs of candidate pipelines
-(:func:`~.accuracy.tuning_jobs`, inside :func:`~.accuracy.tuning_session`), then for
-each candidate fits the :class:`~swarmtopo.readers.ratio.RatioClassifier` thresholds
-(q_1, tau_1) by grid search on the stored per-window diagrams -- the thresholds change
-only which bars count, so no job is rerun -- for each way of pooling the windows, with
-a cross-validated count beside the fitted one (:func:`cross_validated`).  The
-confidence model of the chosen candidate is then fitted on the same tuning maps,
-cross-fitted (:func:`calibrated_classifier`, :func:`cross_fitted_features`), and on
-the calibration grid's maps read the same way (:func:`features_under`), and last the
-power of a several-region map's product of regional confidences on the tuning maps of
-several rooms (:func:`several_region_products`, :func:`fit_regions_exponent`).
-
-``lab/fit_agreement_gate.py`` fits the ``gated`` preset from the default's q_1: the
-agreement gate (:func:`fit_gate`: the score threshold a = ln tau_1 and the agreement
-threshold b, on tuning maps whose rows hold every region's A_k) and its confidence the
-same way; with ``--veto`` it measures an agreement veto for the default (:func:`fit_veto`:
-b alone, the default's (q_1, tau_1) kept: the strongest before the first b that breaks a
-tuning map; not adopted, docs/accuracy.md).
+(:func:`~swarmtopo.experiments.accuracy.tuning_jobs`, inside
+:func:`~swarmtopo.experiments.accuracy.tuning_session`), reads each candidate's maps
+from the store (:func:`maps_from_rows`) and fits the
+:class:`~swarmtopo.readers.ratio.RatioClassifier` thresholds (q_1, tau_1) on their
+stored per-window diagrams (:func:`fit_thresholds`: :meth:`RatioClassifier.fit
+<swarmtopo.readers.ratio.RatioClassifier.fit>` on :func:`training_set`) -- the
+thresholds change only which bars count, so no job is rerun -- for each way of pooling
+the windows, with a cross-validated count beside the fitted one
+(:func:`cross_validated`).  The confidence model of the chosen candidate is then fitted
+on the same tuning maps, cross-fitted (:func:`calibrated_classifier`,
+:func:`cross_fitted_features`), and on the calibration grid's maps read the same way
+(:func:`features_under`), and last the power of a several-region map's product of
+regional confidences on the tuning maps of several rooms
+(:func:`several_region_products`, :func:`fit_regions_exponent`).
 """
 
 from __future__ import annotations
@@ -26,23 +23,15 @@ from dataclasses import dataclass
 from typing import Any, Sequence
 
 import numpy as np
-from scipy.ndimage import uniform_filter, uniform_filter1d
 from scipy.optimize import minimize_scalar
 from sklearn.metrics import brier_score_loss, log_loss
 
-from ..swarmtopo.topology.persistence import Diagram
-from ..swarmtopo.readers.agreement import BARS, agreement_array
-from ..swarmtopo.pipeline.map.map import MapConfig, resolve_landmark_bands
-from ..swarmtopo.readers.ratio import (CONFIDENCE_FEATURES, REGIONS_EXPONENT, RatioClassifier, RatioThresholds, pooled_scores,
-                     region_reader, vote, window_scores, windows_span)
-from ..swarmtopo.experiments.sweep import cached_classifier, job_classifier, job_map_config
+from swarmtopo.experiments.sweep import cached_classifier, job_classifier, job_map_config
+from swarmtopo.pipeline import MapConfig
+from swarmtopo.readers.ratio import (CONFIDENCE_FEATURES, REGIONS_EXPONENT, RatioClassifier, RatioThresholds,
+                                     windows_span)
+from swarmtopo.topology.persistence import Diagram
 
-Q_GRID = (0.5, 0.6, 0.7, 0.8, 0.9)
-TAU_GRID = tuple(np.round(np.geomspace(1.2, 12.0, 80), 4))
-"""The (q_1, tau_1) grid."""
-A_GRID = tuple(np.round(np.arange(1.60, 2.2001, 0.02), 2))
-B_GRID = tuple(np.round(np.arange(0.0, 0.9601, 0.02), 2))
-"""The agreement gate's grid: score threshold a = ln tau_1 and agreement threshold b."""
 REGIONS_EXPONENT_RANGE = (0.05, 20.0)
 """Where :func:`fit_regions_exponent` searches the power a of a several-region map's product."""
 PIPELINE_FIELDS = ("metric", "hop_cost", "diffusion_time", "wall_follow_weight", "window_length",
@@ -53,14 +42,17 @@ chosen candidate's must be MapConfig's defaults."""
 
 def job_pipeline(mapping: dict) -> dict:
     """The ``PIPELINE_FIELDS`` a stored job was mapped with (its ``[map]`` table; unset
-    landmark bands resolved by the preset classifier that ran it, as ``run_job`` does)."""
+    landmark bands resolved by the preset classifier that ran it, as the map does)."""
     return pipeline_fields(job_map_config(mapping), cached_classifier(job_classifier(mapping)))
 
 
 def pipeline_fields(config: MapConfig, classifier) -> dict:
-    """``PIPELINE_FIELDS`` of ``config`` as mapped with ``classifier`` (unset bands resolved)."""
-    return {k: resolve_landmark_bands(config, classifier) if k == "landmark_bands" else getattr(config, k)
-            for k in PIPELINE_FIELDS}
+    """``PIPELINE_FIELDS`` of ``config`` as mapped with ``classifier``: unset landmark bands
+    are the classifier's (``landmark_bands``) with maxmin, else (1,)."""
+    bands = config.landmark_bands
+    if bands is None:
+        bands = classifier.landmark_bands if config.subsample == "maxmin" else (1.0,)
+    return {k: tuple(bands) if k == "landmark_bands" else getattr(config, k) for k in PIPELINE_FIELDS}
 
 
 @dataclass(frozen=True)
@@ -72,7 +64,6 @@ class TuningMap:
     true_betti0: int
     true_betti1: int
     cell: str
-    agreement: tuple[np.ndarray | None, ...] = ()  # each region's A_1 .. A_BARS, None where not computed
     spans: tuple[float, ...] = ()  # each region's windows' span T in seconds (ratio.windows_span); () unknown
 
 
@@ -81,34 +72,26 @@ def maps_from_rows(rows: Sequence[dict[str, Any]], cell_of) -> list[TuningMap]:
 
     ``cell_of(config) -> str`` names each row's cell.
     """
-    maps = []
-    for row in rows:
-        if row["error"] is not None:
-            continue
-        regions = tuple(
-            tuple(Diagram.from_json(w["diagram"]) for w in region["windows"])
-            for region in row["diagrams"])
-        agreement = tuple(None if region.get("agreement") is None else agreement_array(region["agreement"])
-                          for region in row["diagrams"])
-        maps.append(TuningMap(regions, int(row["est_betti0"]), int(row["true_betti0"]), int(row["true_betti1"]),
-                              cell_of(row["config"]), agreement,
-                              tuple(windows_span(region["windows"]) for region in row["diagrams"])))
-    return maps
+    return [TuningMap(tuple(tuple(Diagram.from_json(w["diagram"]) for w in region["windows"])
+                            for region in row["diagrams"]),
+                      int(row["est_betti0"]), int(row["true_betti0"]), int(row["true_betti1"]), cell_of(row["config"]),
+                      tuple(windows_span(region["windows"]) for region in row["diagrams"]))
+            for row in rows if row["error"] is None]
+
+
+def training_set(maps: Sequence[TuningMap]) -> tuple[list, np.ndarray, np.ndarray]:
+    """(X, y, beta0_right) of :meth:`RatioClassifier.fit` from tuning maps: each map's
+    regions' window diagrams, its true beta_1, and whether its beta_0 is right."""
+    return ([m.regions for m in maps], np.array([m.true_betti1 for m in maps]),
+            np.array([m.est_betti0 == m.true_betti0 for m in maps]))
 
 
 def exact(maps: Sequence[TuningMap], th: RatioThresholds, pooling: str = "mean") -> np.ndarray:
-    """Whether each map's (beta_0, beta_1) is exactly right under thresholds ``th`` (gated
-    by agreement if ``th.agreement`` is set), its regions' windows pooled by ``pooling``
-    (the literal classifier)."""
-    model = RatioClassifier({1: th}, pooling=pooling)
+    """Whether each map's (beta_0, beta_1) is exactly right under thresholds ``th``, its
+    regions' windows pooled by ``pooling`` (the literal classifier)."""
+    model = RatioClassifier.from_thresholds({1: th}, pooling=pooling)
     return np.array([m.est_betti0 == m.true_betti0 and
-                     sum(_reader(model, m, r).pooled_betti(region)[1] for r, region in enumerate(m.regions))
-                     == m.true_betti1 for m in maps])
-
-
-def _reader(model: RatioClassifier, m: TuningMap, r: int) -> RatioClassifier:
-    """``model`` as it reads region r of map m (:func:`~swarmtopo.readers.ratio.region_reader`)."""
-    return region_reader(model, m.regions[r], m.agreement[r] if len(m.agreement) > r else None)
+                     sum(model.pooled_betti(region)[1] for region in m.regions) == m.true_betti1 for m in maps])
 
 
 @dataclass(frozen=True)
@@ -121,40 +104,10 @@ class Fit:
     pooling: str
 
 
-def _counts_over_tau(scores: np.ndarray) -> np.ndarray:
-    """#{k : scores_k > ln tau} for every tau of TAU_GRID."""
-    ascending = np.sort(scores)
-    return len(scores) - np.searchsorted(ascending, np.log(TAU_GRID), side="right")
-
-
-def grid_estimates(maps: Sequence[TuningMap], pooling: str = "mean") -> np.ndarray:
-    """beta_hat_1 of every map at every grid point, ``(len(maps), len(Q_GRID), len(TAU_GRID))``:
-    :meth:`~swarmtopo.readers.ratio.RatioClassifier.pooled_betti` at once for all tau."""
-    est = np.zeros((len(maps), len(Q_GRID), len(TAU_GRID)), np.int64)
-    for k, m in enumerate(maps):
-        for region in m.regions:
-            for i, q in enumerate(Q_GRID):
-                if pooling == "mean":
-                    est[k, i] += _counts_over_tau(pooled_scores(region, 1, q))
-                else:
-                    counts = np.sort([_counts_over_tau(window_scores(d, 1, q)) for d in region], axis=0)
-                    est[k, i] += counts[(len(region) - 1) // 2]
-    return est
-
-
 def fit_thresholds(maps: Sequence[TuningMap], pooling: str = "mean") -> Fit:
-    """(q_1, tau_1) at the grid point whose mean exact rate over itself and its two tau
-    neighbours (edges repeated) is highest (ties: the first), so the choice sits inside
-    a plateau rather than on a lucky spike.  Neighbours in q are not averaged: l_q grows
-    with q, so the same tau means a different length threshold in the next q row."""
-    truth = np.array([m.true_betti1 for m in maps])
-    beta0 = np.array([m.est_betti0 == m.true_betti0 for m in maps])
-    right = (grid_estimates(maps, pooling) == truth[:, None, None]) & beta0[:, None, None]
-    surface = right.mean(axis=0)
-    smooth = uniform_filter1d(surface, size=3, axis=1, mode="nearest")
-    i, j = np.unravel_index(int(np.argmax(smooth + 1e-9 * surface)), surface.shape)
-    return Fit(thresholds=RatioThresholds(float(Q_GRID[i]), float(TAU_GRID[j])), accuracy=float(surface[i, j]),
-               surface=surface, pooling=pooling)
+    """(q_1, tau_1) of :meth:`RatioClassifier.fit` on ``maps`` (its default grid)."""
+    model = RatioClassifier(pooling=pooling).fit(*training_set(maps))
+    return Fit(model.thresholds_[1], model.accuracy_, model.surface_, pooling)
 
 
 def cross_validated_exact(maps: Sequence[TuningMap], pooling: str = "mean", folds: int = 4,
@@ -177,70 +130,6 @@ def cross_validated(maps: Sequence[TuningMap], pooling: str = "mean", folds: int
     return int(cross_validated_exact(maps, pooling, folds).sum())
 
 
-def gate_estimates(maps: Sequence[TuningMap], q: float, a_values: Sequence[float] = A_GRID) -> np.ndarray:
-    """beta_hat_1 of every map at every (a, b) of the gate's grid, ``(len(maps), len(a_values), len(B_GRID))``:
-    #{k : S_k > a} minus the ranks k <= BARS among them with A_k <= b (NaN A_k vetoes nothing)."""
-    a = np.array(a_values)[:, None, None]
-    b = np.array(B_GRID)[None, :, None]
-    est = np.zeros((len(maps), len(a_values), len(B_GRID)), np.int64)
-    for k, m in enumerate(maps):
-        for r, region in enumerate(m.regions):
-            scores = pooled_scores(region, 1, q)
-            est[k] += (scores[None, :] > a[:, :, 0]).sum(axis=1)[:, None]
-            agreement = m.agreement[r] if len(m.agreement) > r else None
-            if agreement is None:
-                if (scores[:BARS] > min(a_values)).any():
-                    raise ValueError("a tuning map without A_k: fit the gate on maps mapped with agreement='always'")
-                continue
-            top = np.r_[scores[:BARS], np.zeros(BARS)][:BARS][None, None, :]
-            est[k] -= ((top > a) & (agreement[None, None, :] <= b)).sum(axis=2)
-    return est
-
-
-def gate_right(maps: Sequence[TuningMap], q: float, a_values: Sequence[float] = A_GRID) -> np.ndarray:
-    """Whether each map is exactly right at every (a, b) of :func:`gate_estimates`' grid."""
-    truth = np.array([m.true_betti1 for m in maps])
-    beta0 = np.array([m.est_betti0 == m.true_betti0 for m in maps])
-    return (gate_estimates(maps, q, a_values) == truth[:, None, None]) & beta0[:, None, None]
-
-
-def veto_right(maps: Sequence[TuningMap], score_only: RatioThresholds) -> np.ndarray:
-    """``(len(maps), len(B_GRID))``: whether each map is exactly right with ``score_only``'s
-    (q_1, tau_1) and a veto at every b of the grid."""
-    return gate_right(maps, score_only.q, (float(np.log(score_only.tau)),))[:, 0, :]
-
-
-def fit_gate(maps: Sequence[TuningMap], q: float) -> RatioThresholds:
-    """The gate (tau_1 = e^a, b) at the grid point whose mean exact rate over itself and
-    its neighbours in a and b (3 x 3, edges repeated) is highest (ties: the first)."""
-    surface = gate_right(maps, q).mean(axis=0)
-    smooth = uniform_filter(surface, size=3, mode="nearest")
-    i, j = np.unravel_index(int(np.argmax(smooth + 1e-9 * surface)), surface.shape)
-    return RatioThresholds(q, float(np.exp(A_GRID[i])), float(B_GRID[j]))
-
-
-def fit_veto(maps: Sequence[TuningMap], score_only: RatioThresholds) -> RatioThresholds:
-    """The agreement veto alone: ``score_only``'s (q_1, tau_1) kept, b the last of B_GRID
-    before the first at which some map that was right (at the b before, or by the score
-    alone) turns wrong.
-
-    The strongest veto the tuning maps do not pay for: raising b only drops ranks, so each
-    step can only fix maps that count too many or break maps whose holes agree little;
-    the gain lies beyond the suite (noise loops that are not the same loop from window to
-    window, docs/accuracy.md), where no b is chosen.
-    """
-    right = veto_right(maps, score_only)
-    before = exact(maps, score_only)
-    chosen = None
-    for j, b in enumerate(B_GRID):
-        if np.any(before & ~right[:, j]):
-            break
-        chosen, before = float(b), right[:, j]
-    if chosen is None:
-        raise ValueError("even the weakest veto of the grid breaks a tuning map")
-    return RatioThresholds(score_only.q, score_only.tau, chosen)
-
-
 def one_region(maps: Sequence[TuningMap]) -> list[TuningMap]:
     """The maps whose beta_0 is 1 and right: a region's beta_1 outcome is known only when
     the map has one region (the truth is per map)."""
@@ -253,9 +142,8 @@ def features_under(maps: Sequence[TuningMap], th: RatioThresholds,
     the span's where the map knows it) and outcomes of the one-region ``maps`` read with
     thresholds ``th``."""
     single = one_region(maps)
-    model = RatioClassifier({1: th}, pooling=pooling)
-    return ([_reader(model, m, 0).region_features(m.regions[0], 1, span=m.spans[0] if m.spans else None)
-             for m in single],
+    model = RatioClassifier.from_thresholds({1: th}, pooling=pooling)
+    return ([model.region_features(m.regions[0], 1, span=m.spans[0] if m.spans else None) for m in single],
             [bool(ok) for ok in exact(single, th, pooling)])
 
 
@@ -302,7 +190,8 @@ def calibrated_classifier(maps: Sequence[TuningMap], thresholds: RatioThresholds
                                                f"{len(more_features)} calibration-grid maps")
     if not more_features:
         names, calibration = ("z",), f"{folds}-fold cross-fitted"
-    model = RatioClassifier({1: thresholds}, provenance={**provenance, "calibration": calibration}, pooling=pooling)
+    model = RatioClassifier.from_thresholds({1: thresholds}, provenance={**provenance, "calibration": calibration},
+                                            pooling=pooling)
     model.calibrate(features + more_features, correct + more_correct, names)
     # last, the power of a several-region map's product, on the arenas of several rooms
     # read with the final thresholds (chosen on all the tuning maps, these among them)
@@ -321,17 +210,16 @@ def several_region_products(maps: Sequence[TuningMap], model: RatioClassifier) -
     several = [m for m in maps if m.true_betti0 >= 2 and len(m.regions) >= 2]
     log_products, right = [], []
     for m in several:
-        readers = [_reader(model, m, r) for r in range(len(m.regions))]
-        votes = [vote(reader, region) for reader, region in zip(readers, m.regions)]
-        log_products.append(sum(np.log(reader.region_confidence(region, voted)[1])
-                                for reader, region, voted in zip(readers, m.regions, votes)))
-        right.append(sum(voted[0][1] for voted in votes) == m.true_betti1)
+        readings = [model.read(region) for region in m.regions]
+        log_products.append(sum(np.log(reading.confidence[1]) for reading in readings))
+        right.append(sum(reading.betti[1] for reading in readings) == m.true_betti1)
     return np.array(log_products, dtype=float), np.array(right, dtype=bool)
 
 
 def fit_regions_exponent(log_products: np.ndarray, right: np.ndarray) -> float:
-    """The maximum-likelihood a of P(right) = exp(a ln prod_r p_r) (:func:`~swarmtopo.readers.ratio.map_confidence`),
-    on maps with both outcomes; searched in REGIONS_EXPONENT_RANGE."""
+    """The maximum-likelihood a of P(right) = exp(a ln prod_r p_r)
+    (:meth:`~swarmtopo.readers.ratio.RatioClassifier.map_confidence`), on maps with both
+    outcomes; searched in REGIONS_EXPONENT_RANGE."""
     s, y = np.asarray(log_products, dtype=float), np.asarray(right, dtype=bool)
     if len(np.unique(y)) < 2:
         raise ValueError("the regions' exponent needs maps both right and wrong")

@@ -1,10 +1,202 @@
-"""Under CI, property tests draw the same examples on every run: a red CI is a bug in
-the change, never a new random draw (run them locally to explore new examples)."""
+"""Shared fixtures: the command line run in-process, and the logs and maps several tests read.
 
+Under CI, property tests draw the same examples on every run: a red CI is a bug in
+the change, never a new random draw (run them locally to explore new examples).
+
+Simulating and mapping take seconds, so the logs and maps that tests only read are
+made once per session (once per pytest-xdist worker) here.  They are shared: a test
+that changes one copies it first (``shutil.copytree`` into its ``tmp_path``), and
+each fixture checks at teardown that no test changed it.
+"""
+
+import contextlib
+import hashlib
+import io
+import json
 import os
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+from typing import NamedTuple
 
+import pytest
 from hypothesis import settings
 
 settings.register_profile("ci", derandomize=True)
 if os.environ.get("CI"):
     settings.load_profile("ci")
+
+TWO_ROOMS_GEOJSON = {"type": "MultiPolygon", "coordinates": [
+    [[[0, 0], [500, 0], [500, 500], [0, 500], [0, 0]]],
+    [[[600, 0], [1100, 0], [1100, 500], [600, 500], [600, 0]],
+     [[775, 175], [925, 175], [925, 325], [775, 325], [775, 175]]]]}
+"""Two 500 mm rooms 100 mm apart, the second with a 150 mm square hole: beta = (2, 1)."""
+
+
+def run_cli(*args, cwd=None, env=None) -> subprocess.CompletedProcess:
+    """``swarmtopo ARGS`` run in this process: its exit code, stdout and stderr.
+
+    What ``subprocess.run(["swarmtopo", *ARGS], cwd=cwd, env=env, capture_output=True,
+    text=True)`` gives, without a new interpreter's start-up (a second or more per run):
+    ``swarmtopo.cli.main`` with ``sys.argv`` set, stdout and stderr captured, the
+    program named ``swarmtopo`` as the installed script names it, and the warnings
+    filters of a fresh interpreter, a warning printed on stderr as there.  Not
+    thread-safe (it redirects ``sys.stdout``).  What only a process shows -- signals,
+    the imports of start-up, output written by C code straight to the file descriptors,
+    the exit code of a crash -- needs ``python -m swarmtopo`` in a subprocess.
+    """
+    from swarmtopo import cli
+
+    argv = ["swarmtopo", *map(str, args)]
+    stdout, stderr = io.StringIO(), io.StringIO()
+    app, saved_argv, saved_env = cli.app, sys.argv, dict(os.environ)
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+
+    code = 0
+    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr), \
+            contextlib.chdir(cwd or os.getcwd()), warnings.catch_warnings():
+        warnings.resetwarnings()  # a fresh interpreter's filters: each warning once, on stderr
+        warnings.simplefilter("default")
+        for category in (DeprecationWarning, PendingDeprecationWarning, ImportWarning, ResourceWarning):
+            warnings.simplefilter("ignore", category)
+        warnings.showwarning = show
+        if env is not None:
+            os.environ.clear()
+            os.environ.update(env)
+        sys.argv = argv
+        cli.app = lambda **kwargs: app(prog_name="swarmtopo", **kwargs)
+        try:
+            cli.main()
+        except SystemExit as exc:
+            if exc.code is None or isinstance(exc.code, int):
+                code = exc.code or 0
+            else:  # sys.exit(message): printed, exit status 1
+                print(exc.code, file=sys.stderr)
+                code = 1
+        finally:
+            cli.app, sys.argv = app, saved_argv
+            if env is not None:
+                os.environ.clear()
+                os.environ.update(saved_env)
+    return subprocess.CompletedProcess(argv, code, stdout.getvalue(), stderr.getvalue())
+
+
+@pytest.fixture(scope="session")
+def cli():
+    """:func:`run_cli`: ``cli("map", folder, "--out", out)`` -> CompletedProcess."""
+    return run_cli
+
+
+def folder_digest(folder: Path) -> dict[str, str]:
+    """SHA-256 of every file under ``folder``, by relative path."""
+    return {str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+@contextlib.contextmanager
+def unchanged(folder: Path):
+    """Yield; then fail if any file under ``folder`` was added, removed or changed."""
+    before = folder_digest(folder)
+    yield
+    after = folder_digest(folder)
+    changed = sorted(name for name in before.keys() | after.keys() if before.get(name) != after.get(name))
+    assert not changed, f"a test changed the shared {folder}: {changed}; copy it into tmp_path first"
+
+
+class CliLog(NamedTuple):
+    """A log folder ``swarmtopo simulate`` wrote, and that run (its stdout says what it wrote)."""
+
+    folder: Path
+    proc: subprocess.CompletedProcess
+
+
+class CliMap(NamedTuple):
+    """The output folder of ``swarmtopo map``, its map.json read, and the run."""
+
+    folder: Path
+    doc: dict
+    proc: subprocess.CompletedProcess
+
+
+def simulated_log(folder: Path, *args) -> CliLog:
+    proc = run_cli("simulate", *args, "--out", folder)
+    assert proc.returncode == 0, proc.stderr
+    return CliLog(folder, proc)
+
+
+def mapped(log: Path, out: Path, *args) -> CliMap:
+    proc = run_cli("map", log, "--out", out, *args)
+    assert proc.returncode == 0, proc.stderr
+    return CliMap(out, json.loads((out / "map.json").read_text(encoding="utf-8")), proc)
+
+
+@pytest.fixture(scope="session")
+def one_hole_log(tmp_path_factory):
+    """``swarmtopo simulate --holes 1 --agents 200 --duration 20 --seed 4 --truth
+    --trajectories 1``: a random one-hole arena's log folder in csv, with arena.geojson,
+    status, truth and trajectories (``folder, proc = one_hole_log``)."""
+    run = simulated_log(tmp_path_factory.mktemp("one-hole") / "log", "--holes", 1, "--agents", 200,
+                        "--duration", 20, "--seed", 4, "--truth", "--trajectories", 1.0)
+    with unchanged(run.folder):
+        yield run
+
+
+@pytest.fixture(scope="session")
+def one_hole_map(one_hole_log, tmp_path_factory):
+    """``swarmtopo map`` of :func:`one_hole_log` with every option at its default
+    (map.json, figures, report.html), run without ``--quiet``."""
+    run = mapped(one_hole_log.folder, tmp_path_factory.mktemp("one-hole-map") / "map")
+    with unchanged(run.folder):
+        yield run
+
+
+@pytest.fixture(scope="session")
+def two_rooms_log(tmp_path_factory):
+    """``swarmtopo simulate --arena`` :data:`TWO_ROOMS_GEOJSON` ``--agents 300 --duration
+    40 --seed 3`` (the accuracy benchmark's two-rooms budget): a log folder in csv."""
+    root = tmp_path_factory.mktemp("two-rooms")
+    (root / "rooms.geojson").write_text(json.dumps(TWO_ROOMS_GEOJSON), encoding="utf-8")
+    run = simulated_log(root / "log", "--arena", root / "rooms.geojson", "--agents", 300, "--duration", 40,
+                        "--seed", 3)
+    with unchanged(run.folder):
+        yield run
+
+
+@pytest.fixture(scope="session")
+def two_rooms_map(two_rooms_log, tmp_path_factory):
+    """``swarmtopo map -q`` of :func:`two_rooms_log`, every option at its default."""
+    run = mapped(two_rooms_log.folder, tmp_path_factory.mktemp("two-rooms-map") / "map", "--quiet")
+    with unchanged(run.folder):
+        yield run
+
+
+def _log_digest(log) -> str:
+    arrays = (log.t, log.a, log.b, log.status_t, log.status_agent, log.status_state, log.static_agent)
+    digest = hashlib.sha256(json.dumps(log.meta, sort_keys=True, default=str).encode())
+    for array in arrays:
+        digest.update(array.tobytes())
+    return digest.hexdigest()
+
+
+@pytest.fixture(scope="session")
+def demo_run():
+    """The demo's scenario simulated: the one-hole ``default_arena()``, 200 agents, 30 s,
+    seed 0, with truth and trajectories every second (a ``Simulation``; read only)."""
+    from swarmtopo.arena import default_arena
+    from swarmtopo.sim import simulate
+
+    sim = simulate(default_arena(), 200, 30.0, rng=0, truth=True, trajectory_every=1.0)
+    before = _log_digest(sim.log)
+    yield sim
+    assert _log_digest(sim.log) == before, "a test changed the shared demo_run log"
+
+
+@pytest.fixture(scope="session")
+def demo_map(demo_run):
+    """``map_encounters(demo_run.log, MapConfig(seed=0))``: the demo's map (read only)."""
+    from swarmtopo.pipeline import MapConfig, map_encounters
+
+    return map_encounters(demo_run.log, MapConfig(seed=0))

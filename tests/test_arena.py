@@ -20,7 +20,7 @@ from swarmtopo.arena import (
     two_rooms_arena,
 )
 from swarmtopo.errors import ArenaError, InputError, SwarmtopoError
-from swarmtopo.io.logs import read_arena, write_arena
+from swarmtopo.io import read_arena, write_arena
 
 
 def ring_hole(x0, y0, x1, y1):
@@ -101,7 +101,10 @@ BAD_GEOMETRIES = {
                        "holes 0 and 1 overlap or touch (near x=4, y=4)"),
     "overlapping regions": (MultiPolygon([box(0, 0, 10, 10), box(5, 5, 15, 15)]), "regions 0 and 1 overlap"),
     "touching regions": (MultiPolygon([box(0, 0, 10, 10), box(10, 0, 20, 10)]), "regions 0 and 1 overlap or touch"),
-    "collinear shell": (Polygon([(0, 0), (1, 1), (2, 2), (0, 0)]), "region 0 outer wall crosses itself"),
+    "collinear shell": (Polygon([(0, 0), (1, 1), (2, 2), (0, 0)]),
+                        "region 0 outer wall has zero area: its corners are collinear"),
+    "collinear hole": (Polygon(box(0, 0, 10, 10).exterior, [[(1, 5), (3, 5), (8, 5), (1, 5)]]),
+                       "region 0 hole 0 has zero area: its corners are collinear"),
     "two corners": (Polygon([(0, 0), (1, 1), (0, 0), (0, 0)]), "fewer than 3 distinct corners"),
 }
 
@@ -154,6 +157,8 @@ BAD_GEOJSON = {
         "feature 0: geometry type 'Point'"),
     "self-intersecting": ({"type": "Polygon", "coordinates": [[[0, 0], [10, 10], [10, 0], [0, 10], [0, 0]]]},
                           "crosses itself"),
+    "three collinear points": ({"type": "Polygon", "coordinates": [[[0, 0], [250, 100], [500, 200], [0, 0]]]},
+                               "outer wall has zero area: its corners are collinear, it encloses no area"),
 }
 
 

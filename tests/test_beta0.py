@@ -7,11 +7,12 @@ import pytest
 
 from swarmtopo.arena import square_arena, two_rooms_arena
 from swarmtopo.readers.beta0 import FORMED_SHARE, Beta0Evidence, Beta0Model, beta0_evidence, formation_times, shipped_beta0_model
-from swarmtopo.readers.paper import load_classifier
+from swarmtopo.readers.registry import load_classifier
 from swarmtopo.errors import InputError
 from swarmtopo.experiments.sweep import contact_trace
-from swarmtopo.pipeline.map import MapConfig, map_encounters, split_regions
+from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.sim import simulate
+from swarmtopo.viz.summary import advice, map_json
 
 FAST = {"max_landmarks": 80, "window_scales": (1.0,)}
 
@@ -112,21 +113,20 @@ def test_shipped_model_is_fitted_so_that_more_evidence_means_more_confidence():
 def test_a_room_cut_before_its_agents_met_is_not_reported_as_several_rooms_with_certainty():
     # a dense start in one room: in its first second the swarm is still separate groups
     log = simulate(square_arena(), 300, 1.0, rng=1).log
-    split = split_regions(log, MapConfig())
-    assert split.beta0.regions >= 2 and split.beta0.settled < 2
     tmap = map_encounters(log, MapConfig(**FAST))
+    assert tmap.beta0_evidence.regions >= 2 and tmap.beta0_evidence.settled < 2
     assert tmap.betti[0] >= 2 and tmap.confidence[0] < 0.5
-    assert any("only a longer log tells one room from several" in line for line in tmap.advice())
-    assert tmap.to_json()["beta0_evidence"]["regions"] == tmap.betti[0]
-    assert any("swarmtopo plan --area" in line for line in tmap.advice())
+    assert any("only a longer log tells one room from several" in line for line in advice(tmap))
+    assert map_json(tmap)["beta0_evidence"]["regions"] == tmap.betti[0]
+    assert any("swarmtopo plan --area" in line for line in advice(tmap))
     # the same encounters as a contact trace: plan's model of contact traces is offered
     trace = map_encounters(contact_trace(log), MapConfig(**FAST))
     assert trace.classifier["classifier"] == "trace" and trace.confidence[0] == tmap.confidence[0]
-    assert not any("swarmtopo plan --area" in line for line in trace.advice())
-    assert any("swarmtopo plan --input contact-trace --area" in line for line in trace.advice())
+    assert not any("swarmtopo plan --area" in line for line in advice(trace))
+    assert any("swarmtopo plan --input contact-trace --area" in line for line in advice(trace))
     # it is the log that is a trace, whichever classifier reads it
-    read_as_paper = map_encounters(contact_trace(log), MapConfig(**FAST), classifier=load_classifier("paper"))
-    assert any("swarmtopo plan --input contact-trace --area" in line for line in read_as_paper.advice())
+    read_as_paper = map_encounters(contact_trace(log), MapConfig(**FAST), reader=load_classifier("paper"))
+    assert any("swarmtopo plan --input contact-trace --area" in line for line in advice(read_as_paper))
     # the same room recorded for 20 s: one region, and sure of it
     whole = map_encounters(simulate(square_arena(), 300, 20.0, rng=1).log, MapConfig(**FAST))
     assert whole.betti[0] == 1 and whole.confidence[0] > 0.95
@@ -134,8 +134,8 @@ def test_a_room_cut_before_its_agents_met_is_not_reported_as_several_rooms_with_
 
 def test_two_rooms_recorded_long_enough_are_two_rooms_with_confidence():
     model = shipped_beta0_model()
-    short, long = (split_regions(simulate(two_rooms_arena(), 200, duration, rng=7).log, MapConfig()).beta0
-                   for duration in (20.0, 40.0))
+    short, long = (map_encounters(simulate(two_rooms_arena(), 200, duration, rng=7).log,
+                                  MapConfig(**FAST)).beta0_evidence for duration in (20.0, 40.0))
     assert short.regions == long.regions == 2 and short.settled < long.settled
     # the longer the rooms stay apart, the surer the count
     assert model.confidence(short) < model.confidence(long) and model.confidence(long) > 0.9

@@ -10,9 +10,10 @@ from hypothesis import strategies as st
 from sklearn.base import clone
 
 from swarmtopo.readers.paper import (
-    PAPER_THETA, BettiClassifier, Theta, betti_function, detection_scores, load_classifier,
-    mean_absolute_error, paper_classifier, _best_tau,
+    PAPER_THETA, BettiClassifier, Theta, betti_function, detection_scores, mean_absolute_error,
+    published_paper_classifier, _best_tau,
 )
+from swarmtopo.readers.registry import load_classifier
 from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.topology.persistence import Diagram
 
@@ -187,7 +188,7 @@ def test_confidence_features_hand_case():
 
 
 def test_uncalibrated_classifier_reports_no_confidence():
-    model = paper_classifier()
+    model = published_paper_classifier()
     assert model.confidence(diagram([5.0, 1.0, 1.0])) == {1: None}
 
 
@@ -209,7 +210,7 @@ def test_malformed_classifier_files_name_the_file(tmp_path):
     path.write_text(json.dumps({"format": "other"}))
     with pytest.raises(InputError, match="bad.json"):
         load_classifier(path)
-    good = paper_classifier().to_json()
+    good = published_paper_classifier().to_json()
     good["theta"]["1"]["tau"] = -1
     path.write_text(json.dumps(good))
     with pytest.raises(InputError, match="out of range"):
@@ -219,9 +220,10 @@ def test_malformed_classifier_files_name_the_file(tmp_path):
 
 
 @pytest.mark.parametrize("key, model", [("1", {}), ("1", {"intercept": 0.1, "margin": 0.5}),
-                                        ("1", {"intercept": 0.1, "margin": 0.5, "gap": "x"}), ("maps", -3)])
+                                        ("1", {"intercept": 0.1, "margin": 0.5, "gap": "x"}), ("maps", -3),
+                                        ("0", {"intercept": 0.1, "margin": 0.5, "gap": 0.2})])
 def test_an_incomplete_calibration_is_refused_naming_the_file_and_key(tmp_path, key, model):
-    good = load_classifier("paper-form").to_json()
+    good = load_classifier("paper").to_json()
     good["calibration"][key] = model
     path = tmp_path / "c.json"
     path.write_text(json.dumps(good))
@@ -230,10 +232,11 @@ def test_an_incomplete_calibration_is_refused_naming_the_file_and_key(tmp_path, 
     assert (caught.value.file, caught.value.column) == (str(path), f"calibration.{key}")
 
 
-def test_shipped_presets():
-    paper = load_classifier("paper")
-    assert paper.theta_[1] == Theta(*PAPER_THETA[1])
-    trained = load_classifier("paper-form")
-    assert isinstance(trained, BettiClassifier) and trained.provenance_["name"] == "paper-form"
-    assert "script" in trained.provenance_ and "seeds" in trained.provenance_
-    assert trained.calibration_["maps"] > 0
+def test_the_paper_preset_is_the_paper_form_trained_and_theta_star_the_published_one():
+    trained = load_classifier("paper")
+    assert isinstance(trained, BettiClassifier) and trained.provenance_["name"] == "paper"
+    assert trained.provenance_["script"] == "lab/train_classifier.py" and "seeds" in trained.provenance_
+    assert trained.calibration_["maps"] > 0 and trained.landmark_bands == (1.0,)
+    assert trained.theta_[1] != Theta(*PAPER_THETA[1])  # trained on our environments, not the published one
+    published = published_paper_classifier()
+    assert published.theta_ == {1: Theta(0.5, 0.7, 3.7)} and not hasattr(published, "calibration_")

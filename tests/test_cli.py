@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 from swarmtopo.readers.paper import load_classifier
-from swarmtopo.io.logs import read_log, strip_ground_truth
-from swarmtopo.pipeline.map import MapConfig, fitted_landmark_bands
+from swarmtopo.io import read_log, strip_ground_truth
+from swarmtopo.pipeline import MapConfig
+from swarmtopo.viz.text import format_confidence
 
 
 def run(*args, cwd=None):
@@ -121,14 +122,15 @@ def test_demo_prints_recovered_and_true_betti_numbers(tmp_path):
     assert not (earlier / "events.parquet").exists() and read_log(earlier).n_agents == 200
     assert json.loads((earlier / "meta.json").read_text())["written_by"] == "swarmtopo demo"
     doc = json.loads((tmp_path / "demo" / "map.json").read_text())
-    # the verdict is map.json's, with each Betti number's confidence in percent
+    # the verdict is map.json's, with each Betti number's confidence in percent as report.html shows it
     b1, c0, c1 = doc["betti"]["1"], doc["confidence"]["0"], doc["confidence"]["1"]
-    assert f"recovered: beta_0 = 1 ({100 * c0:.0f}% confidence), beta_1 = {b1} ({100 * c1:.0f}% confidence)" \
-        in proc.stdout
+    assert (f"recovered: beta_0 = 1 ({format_confidence(c0)} confidence), beta_1 = {b1} "
+            f"({format_confidence(c1)} confidence)") in proc.stdout
+    html = (tmp_path / "demo" / "report.html").read_text(encoding="utf-8")
+    assert f">{format_confidence(c0)}</span> confidence" in html
     assert "true:      beta_0 = 1, beta_1 = 1" in proc.stdout
     assert (tmp_path / "demo" / "map.json").exists() and (tmp_path / "demo" / "log" / "events.csv").exists()
     # the report carries the swarm animation from the demo's sampled trajectories
-    html = (tmp_path / "demo" / "report.html").read_text(encoding="utf-8")
     assert "The swarm" in html and '"frames"' in html
 
 
@@ -142,6 +144,13 @@ def test_demo_never_replaces_a_log_it_did_not_write(tmp_path):
                           "events.parquet", "choose another --out")
     assert {p.name: p.read_bytes() for p in log.iterdir()} == before
     assert sorted(p.name for p in folder.iterdir()) == ["log"]
+    # nor a map beside no log of its own
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "map.json").write_text("{}")
+    assert_one_line_error(run("demo", "--out", other), f"{other}: already holds a map that swarmtopo demo did not "
+                          "write (map.json); choose another --out")
+    assert sorted(p.name for p in other.iterdir()) == ["map.json"]
 
 
 def test_bad_events_file_is_one_line_naming_file_row_column_value(tmp_path):
@@ -180,7 +189,8 @@ def test_out_that_is_a_file_is_one_line(simulated, tmp_path):
 
 
 def test_missing_folder_is_one_line(tmp_path):
-    assert_one_line_error(run("map", tmp_path / "nowhere"), "nowhere")
+    assert_one_line_error(run("map", tmp_path / "nowhere"), f"{tmp_path / 'nowhere'}: log folder not found")
+    assert list(tmp_path.iterdir()) == []  # not made by the map's default --out nowhere/map
 
 
 def test_overlapping_holes_arena_is_one_line(tmp_path):
@@ -196,11 +206,10 @@ def test_overlapping_holes_arena_is_one_line(tmp_path):
 def test_bad_option_values(simulated, tmp_path):
     log = simulated[0]
     assert_one_line_errors(
-        (("map", log, "--out", tmp_path / "x", "--metric", "euclid"), ("unknown metric 'euclid'",), 2),
+        (("map", log, "--out", tmp_path / "x", "--metric", "euclid"), ("'euclid' is not one of plain, contracted, hybrid",), 2),
         (("map", log, "--max-windows", 2), ("at least the number of window scales",), 2),
-        (("map", log, "--agreement", "never"), ("agreement must be one of auto, always",), 2),
         (("map", log, "--landmarks", 2001), ("'--landmarks'",), 2),
-        *((("map", log, "--window", window), ("would hold nothing",), 2) for window in ("inf:", ":-inf")),
+        *((("map", log, "--window", window), ("that can hold something",), 2) for window in ("inf:", ":-inf")),
         (("map", log, "--window", "1e9:2e9"),
          ("no encounter events in the window [1000000000, 2000000000] s; the log's events run from",), 1),
         (("map", log, "--window", "abc"), ("T0:T1",), 2),
@@ -253,16 +262,16 @@ def test_runs_too_big_are_refused_naming_the_options(tmp_path):
 def test_the_limits_the_cli_states_without_importing_them_are_the_librarys():
     """The CLI keeps its start-up light by stating these limits in its own code and help."""
     from swarmtopo import cli
-    from swarmtopo.pipeline.map import MAX_LANDMARKS
+    from swarmtopo.pipeline.config import MAX_LANDMARKS
     from swarmtopo.sim.simulate import MAX_AGENT_STEPS, MAX_AGENTS
 
-    assert cli.MAX_LANDMARKS_OPTION == MAX_LANDMARKS
+    assert f"3..{MAX_LANDMARKS}" in Path(cli.__file__).read_text()
     source = Path(cli.__file__).read_text()
     assert f"at most {MAX_AGENTS:,}; agents x duration / dt at most {MAX_AGENT_STEPS:.0e}".replace("e+", "e") in source
 
 
 def test_simulate_scales_a_file_arena_and_refuses_holes_with_it(tmp_path):
-    from swarmtopo.io.logs import read_arena
+    from swarmtopo.io import read_arena
 
     path = tmp_path / "arena.geojson"
     path.write_text(json.dumps({"type": "Polygon", "coordinates": [
@@ -277,12 +286,25 @@ def test_simulate_scales_a_file_arena_and_refuses_holes_with_it(tmp_path):
 
 
 def test_simulate_summary_says_the_time_simulated(tmp_path):
-    for duration, dt, simulated in ((10, 0.3, 9.9), (0.04, 0.1, 0.0)):
+    for duration, dt in ((9.9, 0.3), (0.1, 0.1)):
         out = tmp_path / f"d{duration}"
         proc = run("simulate", "--agents", 10, "--duration", duration, "--dt", dt, "--out", out)
         assert proc.returncode == 0, proc.stderr
-        assert json.loads((out / "meta.json").read_text())["duration"] == simulated
-        assert f" agents over {simulated:g} s in an arena" in proc.stdout
+        assert json.loads((out / "meta.json").read_text())["duration"] == duration
+        assert f" agents over {duration:g} s in an arena" in proc.stdout
+
+
+def test_a_duration_that_is_not_whole_time_steps_is_a_usage_error(tmp_path):
+    out = tmp_path / "o"
+    assert_one_line_errors(
+        (("simulate", "--duration", 0.1, "--dt", 0.5, "--out", out),
+         ("--duration, --dt", "duration 0.1 s is not a whole number of time steps dt = 0.5 s (0.2 steps); use 0.5 s"),
+         2),
+        (("simulate", "--duration", 1, "--dt", 0.3, "--out", out),
+         ("--duration, --dt", "duration 1 s is not a whole number of time steps dt = 0.3 s (3.33333 steps); use 0.9 s "
+          "or 1.2 s"), 2),
+        (("simulate", "--duration", 0, "--out", out), ("'--duration'", "0 is not a finite number > 0"), 2))
+    assert not out.exists()
 
 
 def test_option_values_out_of_range_name_the_option_in_short(tmp_path):
@@ -295,7 +317,7 @@ def test_option_values_out_of_range_name_the_option_in_short(tmp_path):
                           "'--static-time'", "inf is not a finite number", code=2)
     assert not out.exists()
     proc = run("map", tmp_path, "--window-scales", "1,1e-300")
-    assert_one_line_error(proc, "'--window-scales'", "each at least 0.05", code=2)
+    assert_one_line_error(proc, "'--window-scales'", "each a finite number >= 0.05", code=2)
     assert len(proc.stderr) < 200
 
 
@@ -356,8 +378,7 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
          "--wall-follow-weight", "1.5"),
         ("map", log, "--out", tmp_path / "a", "-q", "--window-length", "auto"),
         ("map", log, "--out", tmp_path / "c", "-q", "--window-length", "4", "--max-windows", "3"),
-        ("map", log, "--out", tmp_path / "i", "-q", "--window-length", "4", "--agreement", "always",
-         "--window-scales", "0.5,1"),
+        ("map", log, "--out", tmp_path / "i", "-q", "--window-length", "4", "--window-scales", "0.5,1"),
         ("map", log, "--out", tmp_path / "e", "-q", "--window-length", "4", "--max-windows", "none",
          "--landmark-bands", "1,0.5"))
     assert paper.returncode == 0, paper.stderr
@@ -378,7 +399,7 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     assert doc["params"]["window_length"] is None and "encounters" in doc["params"]["window_source"]
     assert doc["params"]["wall_follow_weight"] == MapConfig.wall_follow_weight
     assert doc["params"]["window_scales"] == list(MapConfig.window_scales)
-    assert doc["params"]["landmark_bands"] == list(fitted_landmark_bands(load_classifier("default")))  # unset: its own
+    assert doc["params"]["landmark_bands"] == list(load_classifier("default").landmark_bands)  # unset: its own
     assert doc["params"]["max_windows"] == MapConfig.max_windows
     assert capped.returncode == 0, capped.stderr
     doc = json.loads((tmp_path / "c" / "map.json").read_text())
@@ -388,8 +409,6 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     assert inspected.returncode == 0, inspected.stderr
     doc = json.loads((tmp_path / "i" / "map.json").read_text())
     assert doc["params"]["window_scales"] == [0.5, 1.0]
-    agreement = doc["regions"][0]["agreement"]
-    assert len(agreement) == 5 and all(0 <= a <= 1 for a in agreement)
     assert every.returncode == 0, every.stderr
     doc = json.loads((tmp_path / "e" / "map.json").read_text())
     assert doc["params"]["max_windows"] is None and len(doc["regions"][0]["windows"]) > 3
@@ -397,23 +416,23 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
     assert [w["band"] for w in doc["regions"][0]["windows"]][:2] == [1.0, 0.5]
     assert_one_line_errors(
         *((("map", log, "--max-windows", bad), ("whole number >= 1",), 2) for bad in ("0", "-1", "2.5", "abc")),
-        (("map", log, "--max-windows", "2"), ("--max-windows must be a whole number, at least the number of "
+        (("map", log, "--max-windows", "2"), ("'--max-windows': must be a whole number, at least the number of "
                                                "window scales (3: one window per length), or 'none'; got 2",), 2),
         (("map", log, "--paper", "--max-windows", "5"), ("--paper fixes --max-windows",), 2),
-        (("map", log, "--landmark-bands", "1,1.5"), ("distinct numbers in (0, 1]",), 2),
+        (("map", log, "--landmark-bands", "1,1.5"), ("each a finite number > 0 and <= 1",), 2),
         (("map", log, "--landmark-bands", "0.5,x"), ("comma-separated",), 2),
-        (("map", log, "--landmark-bands", "0.5,0.5"), ("must be distinct",), 2),
+        (("map", log, "--landmark-bands", "0.5,0.5"), ("list of distinct numbers",), 2),
         (("map", log, "--landmark-bands", "0.5", "--subsample", "knn"), ("use maxmin",), 2),
         (("map", log, "--paper", "--landmark-bands", "1,0.5"), ("--paper fixes --landmark-bands",), 2),
-        (("map", log, "--window-scales", "1,0"), ("distinct positive numbers",), 2),
+        (("map", log, "--window-scales", "1,0"), ("each a finite number >= 0.05",), 2),
         (("map", log, "--window-scales", "1,x"), ("comma-separated",), 2),
         (("map", log, "--paper", "--window-scales", "1,2"), ("--paper fixes --window-scales",), 2),
         (("map", log, "--paper", "--hop-cost", "1"), ("--paper fixes --hop-cost",), 2),
         (("map", log, "--paper", "--diffusion-time", "1"), ("--paper fixes --diffusion-time",), 2),
-        (("map", log, "--window-length", "-3"), ("positive number",), 2),
-        (("map", log, "--diffusion-time", "0"), ("positive number",), 2),
+        (("map", log, "--window-length", "-3"), ("not a finite number > 0",), 2),
+        (("map", log, "--diffusion-time", "0"), ("not a finite number > 0",), 2),
         (("map", log, "--paper", "--wall-follow-weight", "1"), ("--paper fixes --wall-follow-weight",), 2),
-        (("map", log, "--wall-follow-weight", "-1"), ("must be a number in [0, 1e+06]",), 2),
+        (("map", log, "--wall-follow-weight", "-1"), ("not a finite number >= 0 and <= 1e+06",), 2),
         (("map", log, "--hop-cost", "-1"), ("--hop-cost",), 2))
 
 
@@ -421,3 +440,53 @@ def test_bench_and_plan_help_show_examples():
     for args in (("bench", "accuracy", "--help"), ("plan", "--help")):
         proc = run(*args)
         assert proc.returncode == 0 and "Example" in proc.stdout
+
+
+def test_version():
+    from importlib.metadata import version
+
+    proc = run("--version")
+    assert proc.returncode == 0 and proc.stdout == f"swarmtopo {version('swarmtopo')}\n" and proc.stderr == ""
+
+
+@pytest.mark.parametrize("command", [(), ("simulate",), ("ingest",), ("demo",), ("sweep",), ("reproduce",),
+                                     ("plan",), ("bench",), ("bench", "accuracy")])
+def test_help_sends_nobody_to_files_they_do_not_have(command):
+    """A pip install has no docs/ folder: a pointer to one says it is in the source repository."""
+    import re
+
+    proc = subprocess.run([sys.executable, "-m", "swarmtopo", *command, "--help"], capture_output=True, text=True,
+                          timeout=300, env={**os.environ, "COLUMNS": "100"})
+    assert proc.returncode == 0, proc.stderr
+    text = re.sub(r"[\s│]+", " ", proc.stdout)  # the help as one line, without Rich's box
+    assert "Usage:" in text
+    for m in re.finditer(r"docs/", text):
+        assert re.match(r"docs/[\w.-]+\.md in the source repository", text[m.start():]), text[m.start() - 80:][:200]
+
+
+def test_map_replaces_a_map_only_with_overwrite(simulated, tmp_path):
+    out = tmp_path / "m"
+    out.mkdir()
+    (out / "map.json").write_text("{}")
+    (out / "notes.txt").write_text("mine")
+    assert_one_line_error(run("map", simulated[0], "--out", out),
+                          f"{out}: already holds a map (map.json); pass --overwrite to replace it, or choose another "
+                          "--out")
+    assert (out / "map.json").read_text() == "{}"
+    proc = run("map", simulated[0], "--out", out, "--overwrite", "--landmarks", 100, "-q")
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads((out / "map.json").read_text())["params"]["landmarks"] == 100
+    assert sorted(p.name for p in out.iterdir()) == ["cloud.png", "diagram.png", "map.json", "notes.txt",
+                                                     "report.html"]
+
+
+def test_reproduce_replaces_its_own_outputs_only(tmp_path):
+    out = tmp_path / "r"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    (out / "land2-runs.png").write_text("an earlier run's figure")  # land2 no longer draws it: removed
+    proc = run("reproduce", "land2", "--runs", 1, "--out", out)
+    assert proc.returncode == 0, proc.stderr
+    assert sorted(p.name for p in out.iterdir()) == ["land2.csv", "land2.json", "land2.md", "land2.png", "notes.txt"]
+    assert f"wrote {out / 'land2.png'}, {out / 'land2.csv'}, {out / 'land2.md'}, {out / 'land2.json'}" in proc.stdout
+    assert [p.name for p in tmp_path.iterdir()] == ["r"]

@@ -12,8 +12,6 @@ from swarmtopo.topology.cycles import (Cycle, encircled_obstacles, event_positio
                               region_cycles, representative_cycles, shortest_odd_loop, wilson_interval)
 from swarmtopo.errors import InputError
 from swarmtopo.topology.persistence import rips_persistence
-from swarmtopo.pipeline.map import MapConfig, map_encounters
-from swarmtopo.sim import simulate
 
 
 def _euclidean(xy):
@@ -158,10 +156,9 @@ def test_scores_and_wilson_interval():
     assert wilson_interval(0, 10) == pytest.approx((0.0, 0.2775), abs=1e-4)
 
 
-def test_simulated_one_hole_cycle_encircles_the_hole():
+def test_simulated_one_hole_cycle_encircles_the_hole(demo_run, demo_map):
     # The demo's log (seed 0, 200 agents x 30 s): the default finds beta_1 = 1 (checked below).
-    sim = simulate(default_arena(), 200, 30.0, rng=0, truth=True)
-    tmap = map_encounters(sim.log, MapConfig(seed=0, embed_dim=0))
+    sim, tmap = demo_run, demo_map
     assert tmap.betti[1] == 1
     (region,) = tmap.regions
     cycles = region_cycles(region)

@@ -15,21 +15,10 @@ import pytest
 
 from swarmtopo.arena import default_arena
 from swarmtopo.errors import InputError, SwarmtopoError
-from swarmtopo.io.logs import (
-    GROUND_TRUTH_FILES,
-    LOG_FORMAT,
-    jsonable,
-    read_arena,
-    read_json,
-    read_log,
-    read_trajectories,
-    read_truth,
-    strip_ground_truth,
-    write_arena,
-    write_json,
-    write_log,
-)
-from swarmtopo.log import EncounterLog
+from swarmtopo._json import jsonable, read_json, write_json
+from swarmtopo.io import read_arena, read_log, read_trajectories, read_truth, strip_ground_truth, write_arena, write_log
+from swarmtopo.io.logs import GROUND_TRUTH_FILES
+from swarmtopo.log import LOG_FORMAT, EncounterLog
 
 FORMATS = ["csv", "parquet"]
 AWKWARD_TIMES = [0.1, 1 / 3, 1e-300, 123456789.12345679, 5e-324, 2.0, 2.0 ** 53 - 1, 0.30000000000000004]
@@ -182,8 +171,10 @@ def test_csv_id_kinds(tmp_path, rows, expected):
 
 
 def test_text_ids_in_status_make_every_id_text(tmp_path):
+    # "A" met nobody: it must be declared (an undeclared one is refused, see below)
     (tmp_path / "events.csv").write_text("t,a,b\n0,1,2\n")
     (tmp_path / "status.csv").write_text("t,agent,state\n0,A,RW\n0,1,WF\n")
+    (tmp_path / "meta.json").write_text('{"agent_ids": [1, 2, "A"]}')
     assert read_log(tmp_path).agent_ids.tolist() == ["1", "2", "A"]
 
 
@@ -293,7 +284,7 @@ def test_ragged_csv_row(tmp_path):
     ("t,a,b\n0,1,2\n".encode("utf-16"), "byte-order mark of UTF-16"),
     (b"\xff\xfet,a,b\n0,1,2\n", "byte-order mark of UTF-16"),
     ("t,a,b\n0,1,2\n".encode("utf-32"), "byte-order mark of UTF-32"),
-    (b"t,a,b,not\xe9\n0,1,2,x\n", "the header row holds the byte 0xe9"),
+    (b"t,a,b,not\xe9\n0,1,2,x\n", "line 1: byte 0xe9 at column 10 is not UTF-8 text (save the file as UTF-8)"),
 ])
 def test_a_file_that_is_not_utf8_is_named(tmp_path, data, fragment):
     (tmp_path / "events.csv").write_bytes(data)
@@ -306,8 +297,9 @@ def test_a_value_that_is_not_utf8_is_located(tmp_path):
     # latin-1 "é" in an ID: row 3 of events; in status, a bad byte in a state label
     (tmp_path / "events.csv").write_bytes(b"t,a,b\n0,1,2\n1,2,3\n2,Jos\xe9,3\n")
     err = read_error(tmp_path)
-    assert (err.file, err.row, err.column, err.value) == (str(tmp_path / "events.csv"), 3, "a", b"Jos\xe9")
-    assert err.reason == "not UTF-8 text"
+    assert (err.file, err.row, err.column, err.value) == (str(tmp_path / "events.csv"), 3, "a", "Jos\ufffd")
+    assert err.reason == "byte 0xe9 at character 4 of the value is not UTF-8 text (save the file as UTF-8)"
+    assert "\\x" not in str(err)  # no Python escape sequence
     (tmp_path / "events.csv").write_text("t,a,b\n0,1,2\n")
     (tmp_path / "status.csv").write_bytes(b"t,agent,state\n0,1,RW\n1,1,\xa7\n")
     err = read_error(tmp_path)
@@ -601,7 +593,7 @@ def test_log_files_that_are_folders_and_odd_meta_keys_are_refused(tmp_path):
     with pytest.raises(InputError, match="is a file, not a log folder"):
         read_log(tmp_path / "log" / "events.csv")
     (tmp_path / "log" / "status.csv").mkdir()
-    with pytest.raises(InputError, match="is a folder, not a log file") as caught:
+    with pytest.raises(InputError, match="is a folder, not a file") as caught:
         read_log(tmp_path / "log")
     assert caught.value.file == str(tmp_path / "log" / "status.csv")
     (tmp_path / "log" / "status.csv").rmdir()
@@ -628,11 +620,8 @@ def test_a_status_file_none_of_whose_agents_met_anyone_is_refused(tmp_path):
     # "a1" in events, "A1" in status: without a declared agent set, nothing ties them together
     err = read_error(folder(tmp_path, "t,a,b\n0,a1,a2\n1,a2,a3\n", status="t,agent,state\n0,A1,WF\n0,A2,RW\n"))
     assert (err.file, err.column, err.value) == (str(tmp_path / "status.csv"), "agent", "A1")
-    assert "none of its agents appears in events.csv" in err.reason
-    # one status agent among the events is enough (the others met nobody, which is fine) ...
-    (tmp_path / "status.csv").write_text("t,agent,state\n0,A1,WF\n0,a2,RW\n")
-    assert read_log(tmp_path).n_agents == 4
-    # ... and so is a declared agent set that holds them all
+    assert "agent never appears in events.csv (none of this file's agents does" in err.reason
+    # a declared agent set that holds them all makes them agents that met nobody
     (tmp_path / "status.csv").write_text("t,agent,state\n0,A1,WF\n")
     (tmp_path / "meta.json").write_text('{"agent_ids": ["a1", "a2", "a3", "A1"]}')
     assert read_log(tmp_path).n_agents == 4
@@ -656,7 +645,7 @@ def test_a_ragged_row_that_is_not_utf8_is_named_without_a_traceback(tmp_path, mo
     monkeypatch.setattr("sys.unraisablehook", unraisable.append)
     (tmp_path / "events.csv").write_bytes(b"t,a,b\n0,1,2\n1,Jos\xe9\n")
     err = read_error(tmp_path)
-    assert err.reason == "not UTF-8 text: line 3 holds the byte 0xe9; save the file as UTF-8"
+    assert err.reason == "line 3: byte 0xe9 at column 6 is not UTF-8 text (save the file as UTF-8)"
     assert unraisable == []
 
 
@@ -746,3 +735,50 @@ def test_status_rows_count_blank_lines(tmp_path):
     assert "row 2 says agent 1 is RW" in str(err) and "row 4 says S" in str(err)
     err = read_error(folder(tmp_path, "t,a,b\n0,1,2\n", status="t,agent,state\n\n0,1,RW\n\n1,2,walk\n"))
     assert (err.row, err.column, err.value) == (4, "state", "walk")
+
+
+# -- input the issue-39 review found mishandled ------------------------------------------------
+def test_a_status_agent_that_is_in_no_event_is_refused_unless_declared(tmp_path):
+    events = "t,a,b\n0,1,2\n1,2,3\n"
+    err = read_error(folder(tmp_path, events, status="t,agent,state\n0,1,RW\n\n2,9,S\n"))
+    assert (err.file, err.row, err.column, err.value) == (str(tmp_path / "status.csv"), 3, "agent", "9")
+    assert err.reason.startswith("agent never appears in events.csv (an agent that met nobody is declared")
+    # declared, it is an agent that met nobody: by its ID or by the count of IDs 0 .. n-1
+    (tmp_path / "meta.json").write_text('{"agent_ids": [1, 2, 3, 9]}')
+    log = read_log(tmp_path)
+    assert log.agent_ids.tolist() == [1, 2, 3, 9] and log.ids_of(log.status_agent).tolist() == [1, 9]
+    (tmp_path / "meta.json").write_text('{"agent_count": 10}')
+    assert read_log(tmp_path).n_agents == 10
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_gzipped_csv_tables_are_read_and_two_versions_of_a_table_refused(tmp_path, fmt):
+    log = make_log("text")
+    truth, traj = truth_and_trajectories(log)
+    write_log(log, tmp_path / "plain", truth=truth, trajectories=traj)
+    gz = tmp_path / "gz"
+    gz.mkdir()
+    for path in (tmp_path / "plain").iterdir():
+        target = gz / (path.name + ".gz" if path.suffix == ".csv" else path.name)
+        target.write_bytes(gzip.compress(path.read_bytes()) if path.suffix == ".csv" else path.read_bytes())
+    assert sorted(p.name for p in gz.iterdir()) == ["events.csv.gz", "meta.json", "status.csv.gz",
+                                                    "trajectories.csv.gz", "truth.csv.gz"]
+    assert_same_log(read_log(gz), log)
+    assert np.array_equal(read_truth(gz)["xa"], truth["xa"])
+    assert read_trajectories(gz)["agent"].tolist() == traj["agent"].tolist()
+    strip_ground_truth(gz, tmp_path / "stripped")
+    assert sorted(p.name for p in (tmp_path / "stripped").iterdir()) == ["events.csv.gz", "meta.json", "status.csv.gz"]
+    (gz / "events.csv").write_bytes((tmp_path / "plain" / "events.csv").read_bytes())
+    err = read_error(gz)
+    assert (err.file, err.reason) == (str(gz), "both events.csv and events.csv.gz exist; keep one")
+    # a log written over the folder replaces every version of its tables
+    write_log(log, gz, fmt=fmt)
+    assert sorted(p.name for p in gz.iterdir()) == sorted([f"events.{fmt}", "meta.json", f"status.{fmt}"])
+
+
+@pytest.mark.parametrize("name", ["events.csv", "events.csv.gz", "status.csv", "meta.json"])
+def test_a_log_file_that_is_a_folder_is_named_as_one(tmp_path, name):
+    (tmp_path / name).mkdir()
+    if name.startswith("status") or name == "meta.json":
+        (tmp_path / "events.csv").write_text("t,a,b\n0,1,2\n")
+    assert str(read_error(tmp_path)) == f"{tmp_path / name}: is a folder, not a file"

@@ -306,7 +306,7 @@ def test_rounding_noise_bars_are_dropped_relative_to_the_diagram_scale():
 
 def test_simulated_maps_have_no_rounding_noise_bars():
     from swarmtopo.arena import random_arena
-    from swarmtopo.pipeline.map import MapConfig, map_encounters
+    from swarmtopo.pipeline import MapConfig, map_encounters
     from swarmtopo.sim import simulate
 
     sim = simulate(random_arena(2, rng=0), 200, 30.0, rng=0)

@@ -8,13 +8,16 @@ import numpy as np
 import pytest
 
 from swarmtopo.arena import default_arena, square_arena, two_rooms_arena
-from swarmtopo.readers.paper import load_classifier
 from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.log import EncounterLog
-from swarmtopo.pipeline.map import (DIFFUSION_GAP_FACTOR, HOP_GAP_FACTOR, WHOLE_LOG, MapConfig, _share_landmarks,
-                                _scaled_windows, _windows, map_encounters, mean_agent_gap, resolve_diffusion_time, resolve_hop_cost,
-                                fitted_landmark_bands, resolve_window, shipped_classifier_for)
-from swarmtopo.readers.ratio import RatioClassifier, RatioThresholds, region_reader
+from swarmtopo.pipeline import MapConfig, map_encounters, settings
+from swarmtopo.pipeline.config import WHOLE_LOG, ConfigError, config_from_options
+from swarmtopo.pipeline.map import share_landmarks
+from swarmtopo.pipeline.settings import DIFFUSION_GAP_FACTOR, HOP_GAP_FACTOR, mean_agent_gap
+from swarmtopo.pipeline.windows import scaled_windows, window_length, window_spans
+from swarmtopo.readers.ratio import RatioClassifier, RatioThresholds
+from swarmtopo.readers.registry import load_classifier, shipped_reader_for
+from swarmtopo.viz.summary import advice, map_json, window_json
 from swarmtopo.sim import simulate
 
 FAST = dict(embed_dim=0, landmark_bands=(1.0,))
@@ -81,7 +84,7 @@ def test_simulated_arenas_map_to_their_hole_count(arena, holes, recorded):
 
 def test_same_seed_same_map_and_seed_matters():
     log = simulate(default_arena(), 120, 10.0, rng=3).log
-    docs = [map_encounters(log, MapConfig(seed=s, landmarks=60, embed_dim=3)).to_json() for s in (5, 5, 6)]
+    docs = [map_json(map_encounters(log, MapConfig(seed=s, landmarks=60, embed_dim=3))) for s in (5, 5, 6)]
     for d in docs:
         d.pop("timings")
     assert json.dumps(docs[0]) == json.dumps(docs[1])
@@ -123,18 +126,18 @@ def test_empty_windows_do_not_take_seats_under_the_cap():
     # bursts in [30, 40] and [60, 70] of a log from 0 to 110 s: of the 21 windows of 10 s every 5 s, only
     # the two over a burst hold 40 events; an even share of all 21 would be the empty first and last ones
     t = np.r_[0.0, np.linspace(30.0, 40.0, 50), np.linspace(60.0, 70.0, 50), 110.0]
-    assert _scaled_windows(t, [10.0], cap=2)[0] == [(0.0, 10.0), (100.0, 110.0)]
-    spans, left_out = _scaled_windows(t, [10.0], cap=None, min_events=40)
+    assert scaled_windows(t, [10.0], cap=2)[0] == [(0.0, 10.0), (100.0, 110.0)]
+    spans, left_out = scaled_windows(t, [10.0], cap=None, min_events=40)
     assert spans == [(30.0, 40.0), (60.0, 70.0)] and left_out == 0
-    assert _scaled_windows(t, [10.0], cap=2, min_events=40) == (spans, 0)
+    assert scaled_windows(t, [10.0], cap=2, min_events=40) == (spans, 0)
 
 
 def test_windows_too_short_to_list_are_refused_and_too_short_to_hold_a_region_say_so():
     with pytest.raises(SwarmtopoError, match="would be 799,999, more than 100,000: use longer windows"):
-        _windows(np.array([0.0, 40.0]), 1e-4)  # 1 + (40 - 1e-4) / 5e-5 windows
+        window_spans(np.array([0.0, 40.0]), 1e-4)  # 1 + (40 - 1e-4) / 5e-5 windows
     for length, count in ((1e-300, "8e+301"), (1e-320, "inf")):  # said in short, never an OverflowError
         with pytest.raises(SwarmtopoError, match=f"would be {re.escape(count)}, more than 100,000"):
-            _windows(np.array([0.0, 40.0]), length)
+            window_spans(np.array([0.0, 40.0]), length)
     log = simulate(default_arena(), 100, 10.0, rng=3).log
     tmap = map_encounters(log, MapConfig(window_length=0.01, window_scales=(1.0, 2.0), **FAST))
     assert tmap.regions[0].warnings[0] == ("no window (0.01-0.02 s long) holds 50 encounters of this region "
@@ -150,9 +153,9 @@ def test_a_window_of_a_trace_takes_the_hop_cost_of_its_own_pace():
     b = (a + rng.integers(1, 20, len(t))) % 20
     log = EncounterLog.from_records(t, a, b)
     early = map_encounters(log, MapConfig(window=(0.0, 99.9), **FAST))
-    h, _ = resolve_hop_cost(log.window(0.0, 99.9), None)
-    assert early.to_json()["params"]["hop_cost_used"] == pytest.approx(h)
-    assert h < 0.5 * resolve_hop_cost(log, None)[0]
+    h, _ = settings.hop_cost(log.window(0.0, 99.9), None)
+    assert map_json(early)["params"]["hop_cost_used"] == pytest.approx(h)
+    assert h < 0.5 * settings.hop_cost(log, None)[0]
 
 
 def test_window_restricts_events():
@@ -166,9 +169,9 @@ def test_window_restricts_events():
 @pytest.mark.parametrize("bad, match", [
     (dict(metric="euclid"), "unknown metric"),
     (dict(subsample="random"), "unknown subsampler"),
-    (dict(landmarks=2), r"landmarks must be in 3\.\.2000"),
-    (dict(landmarks=2001), r"landmarks must be in 3\.\.2000"),
-    (dict(max_landmarks=2001), r"max_landmarks must be in 3\.\.2000"),
+    (dict(landmarks=2), r"landmarks: must be in 3\.\.2000"),
+    (dict(landmarks=2001), r"landmarks: must be in 3\.\.2000"),
+    (dict(max_landmarks=2001), r"max_landmarks: must be in 3\.\.2000"),
     (dict(maxdim=3), "maxdim"),
     (dict(window=(5.0, 1.0)), "before its start"),
     (dict(hop_cost=-1.0), "hop_cost"),
@@ -188,12 +191,52 @@ def test_bad_config_is_refused(bad, match):
         map_encounters(ring_log(), MapConfig(**bad))
 
 
+@pytest.mark.parametrize("options, field, value", [
+    ({"window_length": "12.5"}, "window_length", 12.5),
+    ({"window_length": "none"}, "window_length", WHOLE_LOG),
+    ({"window_length": "AUTO"}, "window_length", None),
+    ({"diffusion_time": 3}, "diffusion_time", 3.0),
+    ({"wall_follow_weight": "none"}, "wall_follow_weight", None),
+    ({"max_windows": "none"}, "max_windows", None),
+    ({"max_windows": "7"}, "max_windows", 7),
+    ({"window_scales": "1,0.75"}, "window_scales", (1.0, 0.75)),
+    ({"window_scales": [1.25, 1]}, "window_scales", (1.25, 1.0)),
+    ({"landmark_bands": "auto"}, "landmark_bands", None),
+    ({"landmarks": 300}, "landmarks", 300),
+    ({"hop_cost": None}, "hop_cost", None),
+])
+def test_option_values_as_users_write_them(options, field, value):
+    """One parser for command-line text and sweep TOML values: words, numbers, lists."""
+    assert getattr(config_from_options(options), field) == value
+
+
+@pytest.mark.parametrize("options, field, words", [
+    ({"window_length": "soon"}, "window_length", "'soon' is not a finite number > 0 or 'auto' or 'none'"),
+    ({"hop_cost": -1}, "hop_cost", "-1 is not a finite number >= 0 and <= 1e+09 or 'auto'"),
+    ({"max_windows": "2.5"}, "max_windows", "is not a whole number >= 1 or 'none'"),
+    ({"window_scales": "1,1"}, "window_scales", "distinct"),
+    ({"window_scales": "0.01"}, "window_scales", ">= 0.05"),
+    ({"landmark_bands": "1,0.5"}, "landmark_bands", None),  # valid alone: refused with knn below
+    ({"metric": "euclid"}, "metric", "one of plain, contracted, hybrid"),
+    ({"windows": 3}, "windows", "is not an option"),
+])
+def test_bad_option_values_name_their_field(options, field, words):
+    if words is None:
+        with pytest.raises(ConfigError) as caught:
+            config_from_options({**options, "subsample": "knn"})
+    else:
+        with pytest.raises(ConfigError) as caught:
+            config_from_options(options)
+        assert words in caught.value.reason
+    assert caught.value.field == field
+
+
 def test_landmark_shares_follow_events_with_a_minimum_of_three():
-    assert _share_landmarks(300, np.array([1000, 500, 500])).tolist() == [150, 75, 75]
+    assert share_landmarks(300, np.array([1000, 500, 500])).tolist() == [150, 75, 75]
     # largest remainder: 100 * (2/3, 1/3) = 66.67, 33.33 -> 67, 33
-    assert _share_landmarks(100, np.array([200, 100])).tolist() == [67, 33]
+    assert share_landmarks(100, np.array([200, 100])).tolist() == [67, 33]
     # a tiny region still gets 3 (raw share 0.12), so the total may exceed the budget
-    assert _share_landmarks(300, np.array([10000, 4])).tolist() == [300, 3]
+    assert share_landmarks(300, np.array([10000, 4])).tolist() == [300, 3]
 
 
 @pytest.mark.parametrize("metric", ["plain", "hybrid"])
@@ -236,43 +279,43 @@ def test_automatic_landmarks_are_the_shortest_prefix_meeting_the_guarantee():
 def test_windows_hand_computed():
     t = np.array([0.0, 7.0, 30.0])
     # span 30, length 20, step 10: 1 + ceil(10 / 10) = 2 windows, [0, 20] and [10, 30]
-    assert _windows(t, 20.0) == [(0.0, 20.0), (10.0, 30.0)]
+    assert window_spans(t, 20.0) == [(0.0, 20.0), (10.0, 30.0)]
     # span 30, length 12, step 6: 1 + ceil(18 / 6) = 4 windows evenly spaced over [0, 18]
-    assert _windows(t, 12.0) == [(0.0, 12.0), (6.0, 18.0), (12.0, 24.0), (18.0, 30.0)]
+    assert window_spans(t, 12.0) == [(0.0, 12.0), (6.0, 18.0), (12.0, 24.0), (18.0, 30.0)]
     # step 12: 1 + ceil(18 / 12) = 3 windows, starts 0, 9, 18
-    assert _windows(t, 12.0, 12.0) == [(0.0, 12.0), (9.0, 21.0), (18.0, 30.0)]
-    assert _windows(t, 30.0) == [None] and _windows(t, WHOLE_LOG) == [None]
+    assert window_spans(t, 12.0, 12.0) == [(0.0, 12.0), (9.0, 21.0), (18.0, 30.0)]
+    assert window_spans(t, 30.0) == [None] and window_spans(t, WHOLE_LOG) == [None]
 
 
 def test_scaled_windows_are_the_distinct_windows_of_every_length():
     t = np.array([0.0, 7.0, 30.0])
     # 20 s: [0, 20], [10, 30]; 15 s (step 7.5): [0, 15], [7.5, 22.5], [15, 30]; 30 s: the whole log
-    assert _scaled_windows(t, [20.0, 15.0, 30.0]) == ([(0.0, 20.0), (10.0, 30.0), (0.0, 15.0), (7.5, 22.5),
+    assert scaled_windows(t, [20.0, 15.0, 30.0]) == ([(0.0, 20.0), (10.0, 30.0), (0.0, 15.0), (7.5, 22.5),
                                                         (15.0, 30.0), None], 0)
-    assert _scaled_windows(t, [20.0, 20.0]) == (_windows(t, 20.0), 0)  # a window is pooled once
-    assert _scaled_windows(t, [30.0, WHOLE_LOG]) == ([None], 0)
-    assert _scaled_windows(t, [30.0, WHOLE_LOG], cap=1) == ([None], 0)  # counted once, so not over the cap
+    assert scaled_windows(t, [20.0, 20.0]) == (window_spans(t, 20.0), 0)  # a window is pooled once
+    assert scaled_windows(t, [30.0, WHOLE_LOG]) == ([None], 0)
+    assert scaled_windows(t, [30.0, WHOLE_LOG], cap=1) == ([None], 0)  # counted once, so not over the cap
 
 
 def test_capped_windows_keep_an_even_share_of_every_length():
     t = np.array([0.0, 100.0])
     # 10 s: 19 windows every 5 s; 20 s: 9 every 10 s; 28 windows in all
-    every, left_out = _scaled_windows(t, [10.0, 20.0])
-    assert len(every) == 28 and left_out == 0 and _scaled_windows(t, [10.0, 20.0], cap=28) == (every, 0)
+    every, left_out = scaled_windows(t, [10.0, 20.0])
+    assert len(every) == 28 and left_out == 0 and scaled_windows(t, [10.0, 20.0], cap=28) == (every, 0)
     # quotas 7 x 19 / 28 = 4.75 and 7 x 9 / 28 = 2.25: floors 4 and 2, the seat left to the larger remainder
-    capped, left_out = _scaled_windows(t, [10.0, 20.0], cap=7)
+    capped, left_out = scaled_windows(t, [10.0, 20.0], cap=7)
     assert left_out == 21
     # 5 of the 19 10 s windows, indices 0, 4.5, 9, 13.5, 18 rounded half to even; 2 of the 9 20 s ones
     assert capped == [(0.0, 10.0), (20.0, 30.0), (45.0, 55.0), (70.0, 80.0), (90.0, 100.0),
                       (0.0, 20.0), (80.0, 100.0)]
     # one per length at the least, the middle window when only one is kept
-    assert _scaled_windows(t, [10.0, 20.0], cap=2) == ([(45.0, 55.0), (40.0, 60.0)], 26)
+    assert scaled_windows(t, [10.0, 20.0], cap=2) == ([(45.0, 55.0), (40.0, 60.0)], 26)
     with pytest.raises(SwarmtopoError, match="one of each"):
-        _scaled_windows(t, [10.0, 20.0, 50.0], cap=2)
+        scaled_windows(t, [10.0, 20.0, 50.0], cap=2)
 
 
 def test_window_shares_sum_to_the_cap_and_keep_one_per_length():
-    from swarmtopo.pipeline.map import _shares
+    from swarmtopo.pipeline.windows import shares as _shares
 
     # 48 x (399, 3, 2) / 404 = (47.41, 0.36, 0.24): the floors (47, 0, 0) raised to one each exceed
     # the cap, so the largest share gives one back
@@ -288,7 +331,7 @@ def test_window_shares_sum_to_the_cap_and_keep_one_per_length():
 def test_a_long_log_maps_at_most_max_windows():
     import dataclasses
 
-    from swarmtopo.pipeline.map import ADVICE_BELOW
+    from swarmtopo.viz.summary import ADVICE_BELOW
 
     log = simulate(default_arena(), 150, 30.0, rng=2).log
     base = dict(window_length=6.0, window_scales=(1.0, 1.5), **FAST)
@@ -297,11 +340,11 @@ def test_a_long_log_maps_at_most_max_windows():
     assert len(every) > 6 == len(capped.regions[0].windows)
     kept = [(w.t0, w.t1) for w in capped.regions[0].windows]
     assert set(kept) <= {(w.t0, w.t1) for w in every} and len({round(b - a, 9) for a, b in kept}) == 2
-    params = capped.to_json()["params"]
+    params = map_json(capped)["params"]
     assert params["max_windows"] == 6 and params["windows_left_out"] == len(every) - 6
     assert map_encounters(log, MapConfig(max_windows=None, **base)).windows_left_out == 0
     unsure = dataclasses.replace(capped, confidence={0: 0.99, 1: ADVICE_BELOW - 0.2})
-    assert unsure.advice()[-1].startswith("to raise it: use more agents")  # a longer log adds no window
+    assert advice(unsure)[-1].startswith("to raise it: use more agents")  # a longer log adds no window
 
 
 def test_window_scales_pool_the_windows_of_every_scale():
@@ -316,7 +359,7 @@ def test_window_scales_pool_the_windows_of_every_scale():
     bars = [w.diagram for w in mixed.regions[0].windows]
     assert mixed.betti[1] == load_classifier("default").pooled_betti(bars)[1]  # one pooling over them all
     assert mixed.window_length == single[1].window_length  # the scale-1 length is the one reported
-    assert mixed.to_json()["params"]["window_scales"] == [0.75, 1.0, 1.5]
+    assert map_json(mixed)["params"]["window_scales"] == [0.75, 1.0, 1.5]
 
 
 def test_landmark_bands_map_each_window_once_per_band_from_its_middle():
@@ -333,7 +376,7 @@ def test_landmark_bands_map_each_window_once_per_band_from_its_middle():
         assert (times >= w.t0 + quarter - 1e-9).all() and (times <= w.t1 - quarter + 1e-9).all()
     assert any(log.t[w.landmark_events].min() < w.t0 + (w.t1 - w.t0) / 4 for w in windows[::2])
     assert banded.betti[1] == load_classifier("default").pooled_betti([w.diagram for w in windows])[1]
-    assert windows[1].to_json()["band"] == 0.5
+    assert window_json(windows[1])["band"] == 0.5
 
 
 def test_a_band_with_an_empty_middle_is_left_out_and_said():
@@ -359,14 +402,14 @@ def test_unset_landmark_bands_are_the_classifiers_own():
     fitted.provenance_ = {**fitted.provenance_, "pipeline": {"landmark_bands": [1.0, 0.5]}}
     unnamed = load_classifier("default")
     unnamed.provenance_ = {k: v for k, v in unnamed.provenance_.items() if k != "pipeline"}
-    assert fitted_landmark_bands(fitted) == (1.0, 0.5) and fitted_landmark_bands(unnamed) == (1.0,)
-    explicit = map_encounters(log, MapConfig(landmark_bands=(1.0, 0.5), **base), classifier=fitted)
-    resolved = map_encounters(log, MapConfig(**base), classifier=fitted)
-    assert resolved.config.landmark_bands == (1.0, 0.5) and resolved.to_json()["params"]["landmark_bands"] == [1.0, 0.5]
+    assert fitted.landmark_bands == (1.0, 0.5) and unnamed.landmark_bands == (1.0,)
+    explicit = map_encounters(log, MapConfig(landmark_bands=(1.0, 0.5), **base), reader=fitted)
+    resolved = map_encounters(log, MapConfig(**base), reader=fitted)
+    assert resolved.config.landmark_bands == (1.0, 0.5) and map_json(resolved)["params"]["landmark_bands"] == [1.0, 0.5]
     assert [w.diagram.lengths(1).tolist() for w in resolved.regions[0].windows] == \
         [w.diagram.lengths(1).tolist() for w in explicit.regions[0].windows]
-    assert map_encounters(log, MapConfig(**base), classifier=unnamed).config.landmark_bands == (1.0,)
-    knn = map_encounters(log, MapConfig(subsample="knn", **base), classifier=fitted)
+    assert map_encounters(log, MapConfig(**base), reader=unnamed).config.landmark_bands == (1.0,)
+    knn = map_encounters(log, MapConfig(subsample="knn", **base), reader=fitted)
     assert knn.config.landmark_bands == (1.0,)  # bands need maxmin: another subsampler maps whole windows
     assert {w.band for w in knn.regions[0].windows} == {1.0}
 
@@ -391,11 +434,11 @@ def test_bad_window_scales_are_refused(scales, message):
 
 def test_hop_cost_comes_from_meta_then_from_the_data():
     log = EncounterLog.from_records([0.0, 1.0, 3.0, 4.0], [1, 1, 2, 1], [2, 3, 3, 2], meta={"r_d": 30.0, "v_c": 15.0})
-    assert resolve_hop_cost(log, 0.5) == (0.5, "given")
-    assert resolve_hop_cost(log, None) == (2.0, "r_d / v_c from meta.json")
+    assert settings.hop_cost(log, 0.5) == (0.5, "given")
+    assert settings.hop_cost(log, None) == (2.0, "r_d / v_c from meta.json")
     bare = EncounterLog.from_records(log.t, log.a, log.b)
     # consecutive events per agent: 1: 0,1,4 -> gaps 1, 3; 2: 0,3,4 -> 3, 1; 3: 1,3 -> 2: mean 2
-    h, source = resolve_hop_cost(bare, None)
+    h, source = settings.hop_cost(bare, None)
     assert h == pytest.approx(HOP_GAP_FACTOR * 2.0) and "mean time" in source
 
 
@@ -404,23 +447,23 @@ def test_diffusion_time_comes_from_the_data():
     # mean gap between an agent's consecutive encounters 2 s (see the hop-cost test), whatever meta.json says
     gap = mean_agent_gap(log)
     assert gap == pytest.approx(2.0)
-    assert resolve_diffusion_time(gap, 0.3) == (0.3, "given")
-    tau, source = resolve_diffusion_time(gap, None)
+    assert settings.diffusion_time(gap, 0.3) == (0.3, "given")
+    tau, source = settings.diffusion_time(gap, None)
     assert tau == pytest.approx(DIFFUSION_GAP_FACTOR * 2.0) and "mean time" in source
     lonely = EncounterLog.from_records([0.0, 0.0], [1, 3], [2, 4])
-    assert mean_agent_gap(lonely) is None and resolve_diffusion_time(None, None)[0] == WHOLE_LOG
+    assert mean_agent_gap(lonely) is None and settings.diffusion_time(None, None)[0] == WHOLE_LOG
 
 
 def test_window_length_comes_from_the_data():
     log = EncounterLog.from_records([0.0, 1.0, 3.0, 4.0], [1, 1, 2, 1], [2, 3, 3, 2])
     # mean gap between an agent's consecutive encounters 2 s (see the hop-cost test): W = K x 2 s
     gap = mean_agent_gap(log)
-    assert resolve_window(gap, None, 1.5, span=4.0) == (3.0, "1.5 x mean time between an agent's encounters")
-    length, source = resolve_window(gap, None, 25.0, span=4.0)
+    assert window_length(gap, None, 1.5, span=4.0) == (3.0, "1.5 x mean time between an agent's encounters")
+    length, source = window_length(gap, None, 25.0, span=4.0)
     assert length == WHOLE_LOG and "whole log" in source  # 50 s > the log's 4 s
-    assert resolve_window(gap, 2.5, 25.0, span=4.0) == (2.5, "given")
-    assert resolve_window(gap, 9.0, 25.0, span=4.0) == (WHOLE_LOG, "given")
-    assert resolve_window(None, None, 25.0, span=0.0)[0] == WHOLE_LOG  # no agent met twice
+    assert window_length(gap, 2.5, 25.0, span=4.0) == (2.5, "given")
+    assert window_length(gap, 9.0, 25.0, span=4.0) == (WHOLE_LOG, "given")
+    assert window_length(None, None, 25.0, span=0.0)[0] == WHOLE_LOG  # no agent met twice
 
 
 def test_automatic_windows_hold_about_k_encounters_per_agent():
@@ -431,7 +474,7 @@ def test_automatic_windows_hold_about_k_encounters_per_agent():
     assert 1 < len(windows) and all(w.t1 - w.t0 == pytest.approx(length) for w in windows)
     per_agent = [2 * w.n_events / len(np.unique(np.r_[log.a, log.b])) for w in windows]
     assert 0.6 * 8 < np.mean(per_agent) < 1.4 * 8  # about K encounters per agent and window
-    doc = tmap.to_json()["params"]
+    doc = map_json(tmap)["params"]
     assert doc["window_length_used"] == pytest.approx(length) and "8 x mean time" in doc["window_source"]
 
 
@@ -441,15 +484,17 @@ def test_windowed_map_pools_and_records_its_windows():
     region = tmap.regions[0]
     assert len(region.windows) == 4  # span ~30 s, 12 s windows every <= 6 s
     bars = [w.diagram for w in region.windows]
-    classifier = region_reader(load_classifier("default"), bars, region.agreement)
+    classifier = load_classifier("default")
     assert region.betti[1] == classifier.pooled_betti(bars)[1]  # the classifier's pooling of the windows
     assert [w.betti[1] for w in region.windows] == [classifier.betti(w.diagram)[1] for w in region.windows]
     counts = [w.betti[1] for w in region.windows]
     rep = region.windows[region.window].betti[1]  # the representative window agrees with the vote if any does
     assert rep == region.betti[1] or region.betti[1] not in counts
-    assert list(region.counted[1]) == list(classifier.counted_bars(region.diagram, 1, region.betti[1]))
+    assert list(region.counted[1]) == list(classifier.read(bars, [w.n_events for w in region.windows]).counted[1])
+    lengths = region.diagram.lengths(1)  # the counted bars are the region's beta_1 longest
+    assert sorted(lengths[region.counted[1]]) == sorted(lengths)[len(lengths) - region.betti[1]:]
     assert region.diagram is region.windows[region.window].diagram
-    doc = tmap.to_json()
+    doc = map_json(tmap)
     assert [w["betti"]["1"] for w in doc["regions"][0]["windows"]] == [w.betti[1] for w in region.windows]
     assert doc["params"]["hop_cost_used"] == 2.0 and doc["params"]["hop_cost_source"] == "r_d / v_c from meta.json"
     assert doc["params"]["diffusion_time_used"] == pytest.approx(tmap.diffusion_time[0])
@@ -471,69 +516,41 @@ def test_loops_are_drawn_from_the_chosen_window_run_again_with_cocycles():
     assert with_loops.betti == without.betti and with_loops.window == without.window
     assert len(with_loops.cycles) == with_loops.betti[1] and without.cycles == []
 
-def test_the_gate_reads_each_regions_cross_window_agreement():
-    log = simulate(default_arena(), 150, 30.0, rng=2).log
-    config = MapConfig(seed=1, cycles=False, window_length=10.0, window_scales=(1.0,), **FAST)
-    q, tau = 0.5, 4.0
-
-    def mapped(b=None, **options):
-        return map_encounters(log, replace(config, **options), classifier=RatioClassifier({1: RatioThresholds(q, tau, b)}))
-
-    score_only = mapped()
-    assert score_only.regions[0].agreement is None and score_only.timings["agreement"] == 0  # not asked for
-    assert score_only.betti[1] >= 1  # the arena's hole passes the score
-    lenient, strict = mapped(0.0), mapped(0.999)
-    a = lenient.regions[0].agreement
-    assert a.shape == (5,) and np.all((a >= 0) & (a <= 1)) and a[0] > 0.8  # the hole is one loop in every window
-    np.testing.assert_array_equal(strict.regions[0].agreement, a)
-    assert lenient.betti[1] == score_only.betti[1]  # A_k > 0 for every passing rank: nothing vetoed
-    assert strict.betti[1] == 0 and strict.regions[0].counted[1].size == 0  # every passing rank vetoed
-    # the vetoed ranks are named, with their A_k, in map.json and in the region's warnings
-    assert strict.regions[0].vetoed == tuple(range(1, score_only.betti[1] + 1)) and lenient.regions[0].vetoed == ()
-    assert any(f"A_k = {a[0]:.2f}" in w and "not counted" in w for w in strict.regions[0].warnings)
-    assert json.loads(json.dumps(strict.to_json()))["regions"][0]["vetoed"] == list(strict.regions[0].vetoed)
-    # "always": A_k with any classifier, the vote unchanged; map.json lists it
-    always = mapped(agreement="always")
-    np.testing.assert_array_equal(always.regions[0].agreement, a)
-    assert always.betti == score_only.betti
-    assert json.loads(json.dumps(always.to_json()))["regions"][0]["agreement"] == pytest.approx(list(a))
-
-
 def test_a_log_without_status_changes_is_read_by_the_trace_classifier():
     from swarmtopo.experiments.sweep import contact_trace
 
     log = simulate(default_arena(), 150, 30.0, rng=2).log
     trace = contact_trace(log)
-    assert shipped_classifier_for(log) == "default" and shipped_classifier_for(trace) == "trace"
+    assert shipped_reader_for(log) == "default" and shipped_reader_for(trace) == "trace"
     for source, name in ((log, "default"), (trace, "trace")):
         tmap = map_encounters(source, MapConfig(seed=1, cycles=False, **FAST))
         assert tmap.classifier["classifier"] == name
         assert tmap.classifier["theta"] == load_classifier(name).describe()["theta"]
-    given = map_encounters(trace, MapConfig(seed=1, cycles=False, **FAST), classifier=load_classifier("default"))
-    assert given.classifier["classifier"] == "default"  # an explicit classifier is kept
+    given = map_encounters(trace, MapConfig(seed=1, cycles=False, **FAST), reader=load_classifier("default"))
+    assert given.classifier["classifier"] == "default"  # an explicit reader is kept
 
 
 def test_advice_comes_below_the_threshold_and_names_what_would_raise_it():
     import dataclasses
 
-    from swarmtopo.pipeline.map import ADVICE_BELOW
+    from swarmtopo.viz.summary import ADVICE_BELOW
     from swarmtopo.readers.ratio import RESOLUTION_CAP, resolution
 
     log = simulate(default_arena(), 150, 30.0, rng=2).log
     tmap = map_encounters(log, MapConfig(window_length=12.0, window_scales=(1.0,), **FAST))
     sure = dataclasses.replace(tmap, confidence={0: 0.99, 1: ADVICE_BELOW})
-    assert sure.advice() == [] and sure.to_json()["advice"] == []
+    assert advice(sure) == [] and map_json(sure)["advice"] == []
     unsure = dataclasses.replace(tmap, confidence={0: 0.99, 1: ADVICE_BELOW - 0.2})
-    advice = unsure.advice()
-    assert advice[0] == f"beta_1 = {tmap.betti[1]} is uncertain ({100 * (ADVICE_BELOW - 0.2):.0f}% confidence)"
-    assert advice[-1].startswith("to raise it: record longer") and "more agents than 150" in advice[-1]
-    assert "swarmtopo plan" in advice[-1] and unsure.to_json()["advice"] == advice
+    lines = advice(unsure)
+    assert lines[0] == f"beta_1 = {tmap.betti[1]} is uncertain ({100 * (ADVICE_BELOW - 0.2):.0f}% confidence)"
+    assert lines[-1].startswith("to raise it: record longer") and "more agents than 150" in lines[-1]
+    assert "swarmtopo plan" in lines[-1] and map_json(unsure)["advice"] == lines
     # the windows' resolution, the confidence's second feature, is named when beta_1 is in doubt
     places = np.exp(resolution([w.diagram for w in tmap.regions[0].windows]))
     assert places < RESOLUTION_CAP
-    assert sum(f"tell about {places:.0f} places apart" in line for line in advice) == 1
+    assert sum(f"tell about {places:.0f} places apart" in line for line in lines) == 1
     only_beta0 = dataclasses.replace(tmap, confidence={0: ADVICE_BELOW - 0.2, 1: 0.99})
-    assert not any("places apart" in line for line in only_beta0.advice())
+    assert not any("places apart" in line for line in advice(only_beta0))
 
 
 def test_paper_pipeline_is_the_whole_log_without_hop_cost():
@@ -541,7 +558,7 @@ def test_paper_pipeline_is_the_whole_log_without_hop_cost():
     tmap = map_encounters(log, MapConfig(hop_cost=0.0, diffusion_time=WHOLE_LOG, wall_follow_weight=None,
                                          window_length=WHOLE_LOG, **FAST))
     assert len(tmap.regions[0].windows) == 1 and tmap.hop_cost == (0.0, "given")
-    assert tmap.diffusion_time == (WHOLE_LOG, "given") and tmap.to_json()["params"]["diffusion_time_used"] is None
+    assert tmap.diffusion_time == (WHOLE_LOG, "given") and map_json(tmap)["params"]["diffusion_time_used"] is None
     assert tmap.regions[0].windows[0].n_events == log.n_events
 
 
@@ -553,7 +570,7 @@ def test_windows_in_a_gap_of_the_trace_are_skipped():
     tmap = map_encounters(log, MapConfig(metric="plain", window_length=20.0, min_region_events=10, **FAST))
     spans = [(w.t0, w.t1) for w in tmap.regions[0].windows]
     assert spans and all(np.any((log.t >= t0) & (log.t <= t1)) for t0, t1 in spans)
-    assert len(spans) < len(_windows(log.t, 20.0))
+    assert len(spans) < len(window_spans(log.t, 20.0))
 
 
 def test_the_whole_log_fallback_is_said_even_when_no_window_holds_enough_events():
@@ -577,7 +594,7 @@ def test_a_silence_longer_than_a_window_is_a_warning_and_a_day_mapped_alone_has_
     whole = map_encounters(log, MapConfig(**FAST))
     gap = float(np.diff(t).max())
     assert whole.warnings[0].startswith(f"the log is silent for {gap:.6g} s") and "--window T0:T1" in whole.warnings[0]
-    assert whole.to_json()["warnings"][0] == whole.warnings[0]
+    assert map_json(whole)["warnings"][0] == whole.warnings[0]
     day = map_encounters(log, MapConfig(window=(0.0, 100.0), **FAST))
     assert not any("silent" in w for w in day.warnings)
 
@@ -626,8 +643,8 @@ def test_a_silence_that_stretches_the_window_to_the_whole_log_is_still_a_warning
 def test_a_per_hop_cost_from_meta_beyond_the_bound_is_refused(r_d, v_c):
     log = EncounterLog.from_records([0.0, 1.0, 3.0, 4.0], [1, 1, 2, 1], [2, 3, 3, 2], meta={"r_d": r_d, "v_c": v_c})
     with pytest.raises(InputError, match=r"^meta.json: r_d = .* per-hop cost r_d / v_c of .*, more than 1e\+09 s"):
-        resolve_hop_cost(log, None)
-    assert resolve_hop_cost(log, 2.0) == (2.0, "given")  # not read when the cost is given
+        settings.hop_cost(log, None)
+    assert settings.hop_cost(log, 2.0) == (2.0, "given")  # not read when the cost is given
 
 
 def test_a_swarm_static_from_the_start_says_there_is_nothing_to_map():

@@ -1,23 +1,31 @@
-"""Ratio classifier: hand-made diagrams, mean and median pooling, scale invariance, files."""
+"""Ratio classifier: hand-made diagrams, mean and median pooling, scale invariance,
+fitting, files."""
+
+import json
 
 import numpy as np
 import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
-
-from swarmtopo.readers.paper import load_classifier
-from swarmtopo.errors import InputError, SwarmtopoError
-from swarmtopo.topology.persistence import Diagram
 from scipy.special import expit
+from sklearn.base import clone
 
-from swarmtopo.pipeline.map import MapConfig, fitted_landmark_bands
-from swarmtopo.readers.ratio import (LOG_RATIO_CAP, MAX_MARGIN, REGIONS_EXPONENT, RESOLUTION_CAP, SCORE_VAR_PRIOR, Z_CAP,
-                             RatioClassifier, RatioThresholds, SPAN_FEATURES, below_full_resolution, calibrated_probability,
-                             confidence_readout, longest_bars, map_confidence, median_vote, pooled_scores, region_reader,
-                             resolution, windows_span,
-                             score_matrix, score_margin, standardised_margin, vote, window_scores)
+from swarmtopo.errors import InputError, SwarmtopoError
+from swarmtopo.pipeline import MapConfig
+from swarmtopo.readers.ratio import (LOG_RATIO_CAP, MAX_MARGIN, RATIO_FORMAT, REGIONS_EXPONENT, RESOLUTION_CAP,
+                                     SCORE_VAR_PRIOR, SPAN_FEATURES, Z_CAP, RatioClassifier, RatioThresholds,
+                                     below_full_resolution, calibrated_probability, confidence_readout, longest_bars,
+                                     map_confidence, median_vote, pooled_scores, resolution, score_margin,
+                                     score_matrix, standardised_margin, vote, window_scores, windows_span)
+from swarmtopo.readers.registry import load_classifier
+from swarmtopo.topology.persistence import Diagram
 
 TH = RatioThresholds(q=0.5, tau=2.0)
+
+
+def ratio(th, **options):
+    """A ratio classifier of dimension-1 thresholds ``th``."""
+    return RatioClassifier.from_thresholds({1: th}, **options)
 
 
 def diagram(h1):
@@ -39,7 +47,7 @@ def test_window_scores_hand_computed():
 def test_window_count_threshold_and_margin_hand_computed():
     # lengths 4, 1.5, 1: tau = 2 counts lengths > 2 x 1.5 = 3: only [1, 5]
     d = diagram([[1, 5], [2, 3.5], [0.5, 1.5]])
-    model = RatioClassifier({1: TH})
+    model = ratio(TH)
     assert model.betti(d) == {1: 1}
     assert model.length_thresholds(d) == {1: pytest.approx(3.0)}
     # [1, 5] is ln(4/3) above the threshold, [2, 3.5] (score 0) ln 2 below: the margin is ln(4/3)
@@ -55,15 +63,13 @@ def test_mean_pooling_hand_computed_against_the_median():
     # pooled: S_1 = (ln 4 + ln 1.5) / 2 = ln(sqrt 6) > ln 2 -> 1 hole; the lower median of (1, 0) is 0
     w = windows_of([[0, 8], [0, 2], [1, 3], [0, 1]], [[0, 3], [1, 3], [0, 1]])
     assert pooled_scores(w, 1, 0.5) == pytest.approx([np.log(np.sqrt(6)), 0, 0, 0])
-    mean, median = RatioClassifier({1: TH}), RatioClassifier({1: TH}, pooling="median")
+    mean, median = ratio(TH), ratio(TH, pooling="median")
     assert mean.pooled_betti(w) == {1: 1} and median.pooled_betti(w) == {1: 0}
     betti, rep, counts = vote(mean, w)
     assert betti == {1: 1} and counts == {1: [1, 0]} and rep == 0  # the window that agrees
     assert vote(median, w)[:2] == ({1: 0}, 1)
-    # agreement 1/2; margin: S_1 is ln(sqrt 6) - ln 2 above, S_2 = 0 is ln 2 below
     features = mean.region_features(w, 1)
-    assert [features[k] for k in ("agreement", "margin", "windows")] == pytest.approx(
-        [0.5, np.log(np.sqrt(6) / 2), np.log(2)])
+    assert features["windows"] == pytest.approx(np.log(2))
     # z: rank 1 scores ln 4 and ln 1.5 (variance (ln 4 - ln 1.5)^2 / 2 with ddof 1), rank 2 scores 0 and 0
     se1 = np.sqrt(((np.log(4) - np.log(1.5)) ** 2 / 2 + SCORE_VAR_PRIOR) / 2)
     se2 = np.sqrt(SCORE_VAR_PRIOR / 2)
@@ -73,8 +79,8 @@ def test_mean_pooling_hand_computed_against_the_median():
 def test_a_missing_rank_scores_zero():
     # window 1 has two long bars, window 2 one: S_2 = (ln 5 + 0) / 2 = ln sqrt 5 > ln 2
     w = windows_of([[0, 10], [0, 10], [0, 2], [0, 2], [0, 2]], [[0, 10], [0, 2], [0, 2]])
-    assert RatioClassifier({1: TH}).pooled_betti(w) == {1: 2}
-    assert RatioClassifier({1: RatioThresholds(0.5, 2.5)}).pooled_betti(w) == {1: 1}
+    assert ratio(TH).pooled_betti(w) == {1: 2}
+    assert ratio(RatioThresholds(0.5, 2.5)).pooled_betti(w) == {1: 1}
 
 
 def test_score_margin_and_longest_bars_hand_computed():
@@ -111,17 +117,19 @@ def test_score_matrix_pads_missing_ranks_with_zero():
     assert score_matrix(w, 1, 0.5).mean(axis=0) == pytest.approx(pooled_scores(w, 1, 0.5))
 
 
-def test_a_calibration_of_the_older_features_is_applied_as_fitted():
-    # a file calibrated before z: intercept + agreement a + margin m + ln(#windows) coefficients
-    model = RatioClassifier({1: TH}, calibration={"1": {"intercept": -1.0, "agreement": 2.0, "margin": 1.5,
-                                                        "windows": 0.5, "maps": 10}})
-    w = windows_of([[0, 8], [0, 2], [1, 3], [0, 1]], [[0, 3], [1, 3], [0, 1]])
-    a, m = 0.5, np.log(np.sqrt(6) / 2)
-    expected = 1 / (1 + np.exp(-(-1.0 + 2.0 * a + 1.5 * m + 0.5 * np.log(2))))
-    assert model.region_confidence(w)[1] == pytest.approx(expected)
-    assert "agreement" in model.describe()["confidence"]
+def test_a_calibration_weighs_z_and_known_features_only():
+    # the features of calibrations before z (agreement with the vote, log margin, ln #windows) are not read
+    with pytest.raises(InputError, match="a calibration needs 'intercept' and 'z'"):
+        ratio(TH, calibration={"1": {"intercept": -1.0, "agreement": 2.0, "margin": 1.5, "windows": 0.5}})
     with pytest.raises(InputError, match=r"unknown confidence feature\(s\) \['gap'\]"):
-        RatioClassifier({1: TH}, calibration={"1": {"intercept": 0.0, "gap": 1.0}})
+        ratio(TH, calibration={"1": {"intercept": 0.0, "z": 1.0, "gap": 1.0}})
+    with pytest.raises(InputError, match=r"unknown confidence feature\(s\) \['windows'\]"):
+        ratio(TH, calibration={"1": {"intercept": 0.0, "z": 1.0, "windows": 1.0}})
+    with pytest.raises(InputError, match="a dimension the classifier does not read") as caught:
+        ratio(TH, calibration={"2": {"intercept": 0.0, "z": 1.0}})
+    assert caught.value.column == "calibration.2"
+    with pytest.raises(SwarmtopoError, match="z alone"):
+        ratio(TH).calibrate([{"z": 1.0, "windows": 0.0}] * 2, [True, False], names=("z", "windows"))
 
 
 def with_landmarks(n, h1=((1.0, 5.0),)):
@@ -134,7 +142,7 @@ def test_resolution_is_the_mean_log_landmark_count_capped_at_the_automatic_cap()
     # windows of 10 and 1000 landmarks: (ln 10 + ln 400) / 2; the cap is the automatic count's
     w = [with_landmarks(10), with_landmarks(1000)]
     assert resolution(w) == pytest.approx((np.log(10) + np.log(RESOLUTION_CAP)) / 2)
-    assert RatioClassifier({1: TH}).region_features(w, 1)["resolution"] == resolution(w)
+    assert ratio(TH).region_features(w, 1)["resolution"] == resolution(w)
     assert RESOLUTION_CAP == MapConfig().max_landmarks
     assert resolution([with_landmarks(1)]) == 0.0
     # full resolution is the cap, whatever the floating point of exp(mean ln L)
@@ -145,13 +153,13 @@ def test_resolution_is_the_mean_log_landmark_count_capped_at_the_automatic_cap()
 
 def test_confidence_readout_is_the_slope_of_z_and_the_confidence_at_z_zero_per_landmark_count():
     # logit = -3 + 1.2 z + 0.5 ln L + 0.25 z ln L: at L = 1 the slope is 1.2 and P(z = 0) = expit(-3) = 0.047
-    model = RatioClassifier({1: TH}, calibration={"1": {"intercept": -3.0, "z": 1.2, "resolution": 0.5,
+    model = ratio(TH, calibration={"1": {"intercept": -3.0, "z": 1.2, "resolution": 0.5,
                                                         "z_x_resolution": 0.25, "maps": 10}})
     text = confidence_readout(model, landmarks=(1, int(round(np.exp(2)))))
     assert text == ("L = 1: z's slope 1.20, P(right | z = 0) 0.05; "
                     f"L = 7: z's slope {1.2 + 0.25 * np.log(7):.2f}, P(right | z = 0) "
                     f"{1 / (1 + np.exp(3.0 - 0.5 * np.log(7))):.2f}")
-    z_alone = RatioClassifier({1: TH}, calibration={"1": {"intercept": 0.0, "z": 2.0, "maps": 10}})
+    z_alone = ratio(TH, calibration={"1": {"intercept": 0.0, "z": 2.0, "maps": 10}})
     assert confidence_readout(z_alone, landmarks=(20, 400)) == (
         "L = 20: z's slope 2.00, P(right | z = 0) 0.50; L = 400: z's slope 2.00, P(right | z = 0) 0.50")
 
@@ -159,7 +167,7 @@ def test_confidence_readout_is_the_slope_of_z_and_the_confidence_at_z_zero_per_l
 def test_a_calibration_of_z_and_resolution_is_applied_as_fitted_and_one_of_z_alone_ignores_resolution():
     # logit = a + b z + c ln L + d z ln L, hand-computed
     calibration = {"intercept": -3.0, "z": 1.2, "resolution": 0.5, "z_x_resolution": 0.25, "maps": 10}
-    model = RatioClassifier({1: TH}, calibration={"1": calibration})
+    model = ratio(TH, calibration={"1": calibration})
     sparse, fine = [with_landmarks(20)] * 3, [with_landmarks(300)] * 3  # same bars, same z
     z = model.region_features(sparse, 1)["z"]
     assert z == model.region_features(fine, 1)["z"] > 0
@@ -169,14 +177,14 @@ def test_a_calibration_of_z_and_resolution_is_applied_as_fitted_and_one_of_z_alo
         assert model.region_confidence(windows)[1] == pytest.approx(expit(-3.0 + 1.2 * z + 0.5 * ln_l + 0.25 * z * ln_l))
     assert "resolution" in model.describe()["confidence"]
     with pytest.raises(InputError, match="'resolution' and 'z_x_resolution' together"):
-        RatioClassifier({1: TH}, calibration={"1": {"intercept": -3.0, "z": 1.2, "resolution": 0.5}})
-    z_only = RatioClassifier({1: TH}, calibration={"1": {"intercept": -3.0, "z": 1.2}})
+        ratio(TH, calibration={"1": {"intercept": -3.0, "z": 1.2, "resolution": 0.5}})
+    z_only = ratio(TH, calibration={"1": {"intercept": -3.0, "z": 1.2}})
     assert z_only.region_confidence(sparse)[1] == z_only.region_confidence(fine)[1] == pytest.approx(
         expit(-3.0 + 1.2 * z))
 
 
 def test_the_span_features_are_ln_t_and_z_ln_t_and_a_calibration_never_reads_a_missing_feature_as_zero():
-    model = RatioClassifier({1: TH}, calibration={"1": {"intercept": -3.0, "z": 1.2, "resolution": 0.5,
+    model = ratio(TH, calibration={"1": {"intercept": -3.0, "z": 1.2, "resolution": 0.5,
                                                         "z_x_resolution": 0.25, "maps": 10}})
     windows = [with_landmarks(20)] * 3
     plain = model.region_features(windows, 1)
@@ -188,13 +196,13 @@ def test_the_span_features_are_ln_t_and_z_ln_t_and_a_calibration_never_reads_a_m
     with pytest.raises(ValueError, match="weighs resolution, z_x_resolution, which the region's features lack"):
         calibrated_probability(model.calibration_["1"], {"z": plain["z"]})
     with pytest.raises(InputError, match="unknown confidence feature.*log_span"):  # no file weighs the span
-        RatioClassifier({1: TH}, calibration={"1": {"intercept": 0.0, "z": 1.0, "log_span": 0.1}})
+        ratio(TH, calibration={"1": {"intercept": 0.0, "z": 1.0, "log_span": 0.1}})
 
 
 def test_a_map_of_several_regions_raises_the_product_of_their_confidences_to_the_fitted_power():
     calibration = {"intercept": -3.0, "z": 1.2, "maps": 10}
-    plain = RatioClassifier({1: TH}, calibration={"1": calibration})
-    powered = RatioClassifier({1: TH}, calibration={"1": {**calibration, REGIONS_EXPONENT: 0.5}})
+    plain = ratio(TH, calibration={"1": calibration})
+    powered = ratio(TH, calibration={"1": {**calibration, REGIONS_EXPONENT: 0.5}})
     assert map_confidence(plain, [0.9, 0.8]) == pytest.approx(0.72)  # no exponent: the plain product
     assert map_confidence(powered, [0.9, 0.8]) == pytest.approx(0.72 ** 0.5)
     assert map_confidence(powered, [0.9, 0.8, 0.5]) == pytest.approx(0.36 ** 0.5)
@@ -215,7 +223,7 @@ def test_a_map_of_several_regions_raises_the_product_of_their_confidences_to_the
     assert REGIONS_EXPONENT not in powered.calibration_["1"] and "regions_calibration" not in powered.provenance_
     for bad in (0.0, -1.0):
         with pytest.raises(InputError, match="must be positive") as caught:
-            RatioClassifier({1: TH}, calibration={"1": {**calibration, REGIONS_EXPONENT: bad}})
+            ratio(TH, calibration={"1": {**calibration, REGIONS_EXPONENT: bad}})
         assert caught.value.column == f"calibration.1.{REGIONS_EXPONENT}"
 
 
@@ -242,7 +250,7 @@ def test_median_vote_is_the_lower_median():
 
 
 def test_vote_picks_the_agreeing_window_with_the_largest_margin():
-    model = RatioClassifier({1: TH}, pooling="median")
+    model = ratio(TH, pooling="median")
     w = windows_of([[0, 9], [0, 4.1], [0, 1], [0, 1], [0, 1]],  # 2 counted, the second barely (4.1 > 2)
                    [[0, 20], [0, 1], [0, 1]],                     # 1, far from the threshold
                    [[0, 2.5], [0, 1], [0, 1]])                    # 1, ratio 2.5 close to 2
@@ -255,7 +263,7 @@ def test_vote_picks_the_agreeing_window_with_the_largest_margin():
 
 def test_vote_without_windows_is_an_error():
     with pytest.raises(SwarmtopoError, match="no window"):
-        vote(RatioClassifier({1: TH}), [])
+        vote(ratio(TH), [])
 
 
 bar_lists = st.lists(st.tuples(st.floats(0.1, 10), st.floats(0.01, 10)), max_size=12)
@@ -270,20 +278,20 @@ def test_pooled_counts_are_scale_invariant_and_between_the_windows_counts(bars, 
     # a score on the threshold itself (tau = 1 and two equal bars) counts or not by rounding: not a case
     scores = np.r_[pooled_scores(windows_of(*h1s), 1, q), *(window_scores(diagram(h), 1, q) for h in h1s)]
     assume(not np.any(np.abs(scores - np.log(tau)) < 1e-9))
-    model = RatioClassifier({1: RatioThresholds(q, tau)})
+    model = ratio(RatioThresholds(q, tau))
     pooled = model.pooled_betti(windows_of(*h1s))[1]
     assert pooled == model.pooled_betti(windows_of(*(h * c for h in h1s)))[1]
     # every rank's mean score passes when it passes in every window, fails when it fails in every one
     own = [model.betti(diagram(h))[1] for h in h1s]
     assert min(own) <= pooled <= max(own)
     if len(h1s) == 1:  # one window: both poolings are the window's own count
-        assert pooled == own[0] == RatioClassifier({1: RatioThresholds(q, tau)}, pooling="median").pooled_betti(
+        assert pooled == own[0] == ratio(RatioThresholds(q, tau), pooling="median").pooled_betti(
             windows_of(*h1s))[1]
 
 
 def test_calibration_and_json_round_trip(tmp_path):
     rng = np.random.default_rng(0)
-    model = RatioClassifier({1: TH}, provenance={"name": "test"})
+    model = ratio(TH, provenance={"name": "test"})
     regions, correct = [], []
     for _ in range(60):
         clean = rng.random() < 0.5
@@ -302,44 +310,51 @@ def test_calibration_and_json_round_trip(tmp_path):
     assert again.to_json() == model.to_json()
 
 
-def test_earlier_formats_read_as_median_pooling_when_their_gates_are_off():
-    for fmt, extra in (("swarmtopo-ratio-classifier/1", {}), ("swarmtopo-ratio-classifier/2", {"gamma": 0.0})):
-        old = {"format": fmt, "thresholds": {"1": {"q": 0.5, "tau": 2.0, "rho": 1.0, "kappa": 0.0, **extra}}}
-        model = RatioClassifier.from_json(old)
-        assert model.pooling == "median" and model.thresholds_[1] == TH
-        assert model.to_json()["format"] == "swarmtopo-ratio-classifier/4"
-    gated = {"format": "swarmtopo-ratio-classifier/2",
-             "thresholds": {"1": {"q": 0.5, "tau": 2.0, "rho": 2.0, "kappa": 0.0, "gamma": 0.0}}}
-    with pytest.raises(InputError, match="old.json.*thresholds.1.*no longer applied"):
-        RatioClassifier.from_json(gated, source="old.json")
+def test_earlier_formats_are_refused_naming_the_file_and_the_formats():
+    for n in (1, 2, 3, 4):
+        old = {"format": f"swarmtopo-ratio-classifier/{n}", "pooling": "mean",
+               "thresholds": {"1": {"q": 0.5, "tau": 2.0}}}
+        with pytest.raises(InputError) as caught:
+            RatioClassifier.from_json(old, source="old.json")
+        assert (caught.value.file, caught.value.column, caught.value.value) == ("old.json", "format", old["format"])
+        assert f'"{RATIO_FORMAT}"' in caught.value.reason
+    # a threshold of an earlier format's gates (rho, kappa, gamma, the agreement gate) is not the current one's
+    for extra in ({"agreement": 0.7}, {"rho": 1.0}):
+        obj = {"format": RATIO_FORMAT, "pooling": "mean", "thresholds": {"1": {"q": 0.5, "tau": 2.0, **extra}}}
+        with pytest.raises(InputError, match="exactly 'q' and 'tau'") as caught:
+            RatioClassifier.from_json(obj, source="new.json")
+        assert (caught.value.file, caught.value.column) == ("new.json", "thresholds.1")
 
 
 def test_bad_thresholds_and_files_are_input_errors():
     with pytest.raises(InputError, match="1 <= tau < 1000"):
-        RatioClassifier({1: RatioThresholds(0.5, 0.5)})
+        ratio(RatioThresholds(0.5, 0.5))
     with pytest.raises(InputError, match="1 <= tau < 1000"):
-        RatioClassifier({1: RatioThresholds(0.5, 1000.0)})
+        ratio(RatioThresholds(0.5, 1000.0))
     with pytest.raises(InputError, match="q <= 1"):
-        RatioClassifier({1: RatioThresholds(1.5, 2.0)})
+        ratio(RatioThresholds(1.5, 2.0))
     with pytest.raises(InputError, match="pooling"):
-        RatioClassifier({1: TH}, pooling="max")
-    with pytest.raises(InputError, match="malformed"):
-        RatioClassifier.from_json({"format": "swarmtopo-ratio-classifier/3", "thresholds": {"1": {"q": "x"}}})
-    with pytest.raises(InputError, match="pooling"):
-        RatioClassifier.from_json({"format": "swarmtopo-ratio-classifier/3", "pooling": "mode",
-                                   "thresholds": {"1": {"q": 0.5, "tau": 2.0}}})
+        ratio(TH, pooling="max")
+    with pytest.raises(InputError, match="finite number") as caught:
+        RatioClassifier.from_json({"format": RATIO_FORMAT, "pooling": "mean",
+                                   "thresholds": {"1": {"q": "x", "tau": 2}}}, source="c.json")
+    assert (caught.value.file, caught.value.column) == ("c.json", "thresholds.1.q")
+    for pooling in ("mode", None):
+        with pytest.raises(InputError, match="pooling"):
+            RatioClassifier.from_json({"format": RATIO_FORMAT, "pooling": pooling,
+                                       "thresholds": {"1": {"q": 0.5, "tau": 2.0}}})
+    for thresholds in ({}, None, {"0": {"q": 0.5, "tau": 2.0}}, {"x": {"q": 0.5, "tau": 2.0}}):
+        with pytest.raises(InputError, match="thresholds"):
+            RatioClassifier.from_json({"format": RATIO_FORMAT, "pooling": "mean", "thresholds": thresholds})
 
 
-def test_shipped_default_is_a_calibrated_mean_pooled_ratio_classifier_and_gated_its_gated_variant():
-    model = load_classifier("default")
-    assert isinstance(model, RatioClassifier) and model.pooling == "mean"
-    assert set(model.calibration_) == {"1"}  # beta_0's confidence is the pipeline's (swarmtopo.readers.beta0)
-    assert not model.gated and not load_classifier("trace").gated  # the score alone
-    gated = load_classifier("gated")
-    assert gated.gated and 0 < gated.thresholds_[1].agreement < 1 and set(gated.calibration_) == {"1"}
-    # fitted from the previous default's q_1 and tau_1 on its whole-window maps, which it reads with
-    assert gated.thresholds_[1].q == gated.provenance_["score_only"]["q"]
-    assert fitted_landmark_bands(gated) == (1.0,) and "landmark_bands" not in gated.provenance_["pipeline"]
+def test_shipped_default_and_trace_are_calibrated_mean_pooled_ratio_classifiers_of_their_bands():
+    for name, bands in (("default", (1.0, 0.5)), ("trace", (1.0,))):
+        model = load_classifier(name)
+        assert isinstance(model, RatioClassifier) and model.pooling == "mean"
+        assert set(model.calibration_) == {"1"}  # beta_0's confidence is the pipeline's (swarmtopo.readers.beta0)
+        assert model.landmark_bands == bands  # the bands its tuning maps were drawn with
+        assert model.to_json()["format"] == RATIO_FORMAT
 
 
 @pytest.mark.parametrize("name", ["default", "trace"])
@@ -361,8 +376,6 @@ def test_shipped_confidence_rises_with_z_and_with_the_places_resolved(name):
     ("maps", -1, "must be a finite number"),
 ])
 def test_a_classifier_file_with_a_bad_calibration_is_refused_naming_the_file(tmp_path, key, value, message):
-    import json
-
     obj = json.loads(json.dumps(load_classifier("default").to_json()))
     obj["calibration"]["1"][key] = value
     path = tmp_path / "c.json"
@@ -372,86 +385,19 @@ def test_a_classifier_file_with_a_bad_calibration_is_refused_naming_the_file(tmp
     assert (caught.value.file, caught.value.column) == (str(path), f"calibration.1.{key}")
 
 
-def test_an_earlier_classifier_file_with_a_beta0_rate_still_loads(tmp_path):
-    import json
-
+def test_an_earlier_classifier_files_beta0_rate_is_refused(tmp_path):
     obj = json.loads(json.dumps(load_classifier("default").to_json()))
     obj["calibration"]["0"] = {"maps": 1248, "rate": 0.9992}
     path = tmp_path / "c.json"
     path.write_text(json.dumps(obj))
-    assert load_classifier(path).calibration_ == load_classifier("default").calibration_
-
-
-# -- the agreement gate -------------------------------------------------------------------
-GATED = RatioThresholds(q=0.5, tau=2.0, agreement=0.7)
-# three windows, each with bars of lengths 16, 5, 3 over noise of length 2 (median 2):
-# scores ln 8, ln 2.5, ln 1.5, 0...: ranks 1 and 2 pass ln 2, rank 3 does not
-REGION = windows_of(*[[[0, 16], [0, 5], [0, 3], [0, 2], [0, 2], [0, 2], [0, 2]]] * 3)
-
-
-def test_a_passing_rank_with_low_agreement_is_vetoed_and_dropped_from_every_window():
-    model = RatioClassifier({1: GATED})
-    assert model.gated and model.needs_agreement(REGION)
-    assert model.pooled_betti(REGION) == {1: 2}  # the gate needs its A_k: the score alone counts 2
-    view = model.with_agreement(REGION, np.array([0.9, 0.5, 0.1, 0.1, 0.1]))  # rank 3 fails the score anyway
-    assert view.vetoed_ == {1: (1,)} and model.vetoed_ == {}
-    assert view.pooled_betti(REGION) == {1: 1} and view.betti(REGION[0]) == {1: 1}
-    # the drawn bar is the longest; the next counted one would skip the vetoed [0, 5]
-    assert [tuple(REGION[0][1][i]) for i in view.counted_bars(REGION[0], 1, 2)] == [(0.0, 16.0), (0.0, 3.0)]
-    # z is read off the scores without the vetoed rank: ln 8 above, ln 1.5 below ln 2 (not ln 2.5 above)
-    kept = np.delete(score_matrix(REGION, 1, 0.5), 1, axis=1)
-    assert view.region_features(REGION, 1)["z"] == pytest.approx(standardised_margin(kept, 1, 2.0))
-    assert view.region_features(REGION, 1)["z"] != pytest.approx(model.region_features(REGION, 1)["z"])
-    # the literal rule: #{k : S_k > ln tau and not (k <= BARS and A_k <= b)}
-    for agreement, count in (([0.9, 0.9, 0.0, 0.0, 0.0], 2), ([0.7, 0.9, 1, 1, 1], 1), ([0.1, 0.2, 1, 1, 1], 0),
-                             ([np.nan] * 5, 2)):
-        assert model.with_agreement(REGION, np.array(agreement)).pooled_betti(REGION) == {1: count}
-
-
-def test_the_gate_needs_agreement_only_when_a_rank_passes():
-    quiet = windows_of(*[[[0, 3], [0, 2], [0, 2], [0, 2]]] * 2)  # S_1 = ln 1.5 < ln 2
-    model = RatioClassifier({1: GATED})
-    assert not model.needs_agreement(quiet)
-    assert model.with_agreement(quiet, None).pooled_betti(quiet) == {1: 0}
-    with pytest.raises(SwarmtopoError, match="cross-window cycle agreement"):
-        model.with_agreement(REGION, None)
-    assert not RatioClassifier({1: TH}).gated and not RatioClassifier({1: TH}).needs_agreement(REGION)
-
-
-def test_a_gated_classifier_round_trips_and_bad_gates_are_refused(tmp_path):
-    model = RatioClassifier({1: GATED}, provenance={"name": "g"})
-    path = tmp_path / "g.json"
-    model.save(path)
-    again = load_classifier(path)
-    assert again.thresholds_[1] == GATED and again.to_json() == model.to_json()
-    assert again.to_json()["format"] == "swarmtopo-ratio-classifier/4" and "agreement_gate" in again.describe()
-    # a /3 file never had a gate
-    three = {"format": "swarmtopo-ratio-classifier/3", "thresholds": {"1": {"q": 0.5, "tau": 2.0}}}
-    assert not RatioClassifier.from_json(three).gated
-    for thresholds, pooling in (({1: RatioThresholds(0.5, 2.0, 1.0)}, "mean"), ({1: GATED}, "median"),
-                                ({2: GATED}, "mean")):
-        with pytest.raises(InputError, match="agreement gate"):
-            RatioClassifier(thresholds, pooling=pooling)
-    for bad in (False, "0.5", 1.0, -0.1):  # a file's gate is checked like a constructed one's
-        obj = {**model.to_json(), "thresholds": {"1": {"q": 0.5, "tau": 2.0, "agreement": bad}}}
-        with pytest.raises(InputError, match="agreement gate"):
-            RatioClassifier.from_json(obj, source="g.json")
-
-
-def test_region_reader_reads_a_stored_agreement_list_with_nulls_as_nan():
-    model = RatioClassifier({1: GATED})
-    # as map.json and the sweep store hold it: null where no two windows overlap (nothing vetoed)
-    assert region_reader(model, REGION, [0.9, None, None, None, None]).vetoed_ == {}
-    assert region_reader(model, REGION, [0.9, 0.5, None, 0.1, 0.1]).vetoed_ == {1: (1,)}
-    ungated = RatioClassifier({1: TH})
-    assert region_reader(ungated, REGION, None) is ungated  # a score-only classifier never needs A_k
+    with pytest.raises(InputError, match="a dimension the classifier does not read") as caught:
+        load_classifier(path)
+    assert (caught.value.file, caught.value.column) == (str(path), "calibration.0")
 
 
 @pytest.mark.parametrize("model", [{}, {"z": 2.0}, {"intercept": 0.1, "margin": 1.0}, [0.1, 2.0], 0.5],
-                         ids=["empty", "no-intercept", "half-old", "list", "number"])
+                         ids=["empty", "no-intercept", "old-features", "list", "number"])
 def test_an_incomplete_calibration_is_refused_naming_the_file_and_key(tmp_path, model):
-    import json
-
     obj = json.loads(json.dumps(load_classifier("default").to_json()))
     obj["calibration"]["1"] = model
     path = tmp_path / "c.json"
@@ -462,8 +408,6 @@ def test_an_incomplete_calibration_is_refused_naming_the_file_and_key(tmp_path, 
 
 
 def test_an_unknown_classifier_format_lists_the_formats_read(tmp_path):
-    import json
-
     obj = json.loads(json.dumps(load_classifier("default").to_json()))
     obj["format"] = "swarmtopo-ratio-classifier/9"
     path = tmp_path / "c.json"
@@ -471,5 +415,59 @@ def test_an_unknown_classifier_format_lists_the_formats_read(tmp_path):
     with pytest.raises(InputError) as caught:
         load_classifier(path)
     assert (caught.value.file, caught.value.column, caught.value.value) == (str(path), "format", obj["format"])
-    for fmt in ("swarmtopo-classifier/1", "swarmtopo-ratio-classifier/3", "swarmtopo-ratio-classifier/4"):
+    for fmt in ("swarmtopo-classifier/1", RATIO_FORMAT):
         assert f'"{fmt}"' in caught.value.reason
+
+
+# -- fitting ------------------------------------------------------------------------------
+def one_window_map(*h1):
+    """A map of one region mapped in one window with these H1 bars."""
+    return [[diagram(h1)]]
+
+
+# three maps, one window each; l_q is the median length 1 of each window:
+# A (beta_1 = 1): lengths 4, 1, 1        -> counts 1, 1, 0, 0 at tau = 2, 3, 5, 8
+# B (beta_1 = 0): lengths 2.5, 1, 1      -> counts 1, 0, 0, 0
+# C (beta_1 = 2): lengths 10, 6, 1, 1, 1 -> counts 2, 2, 2, 1
+HAND_X = [one_window_map([0, 4], [0, 1], [0, 1]), one_window_map([0, 2.5], [0, 1], [0, 1]),
+          one_window_map([0, 10], [0, 6], [0, 1], [0, 1], [0, 1])]
+HAND_Y = [1, 0, 2]
+HAND_TAU = (2.0, 3.0, 5.0, 8.0)
+
+
+def test_fit_recovers_the_hand_computed_threshold_inside_the_plateau():
+    # right maps at tau = 2, 3, 5, 8: {A, C}, {A, B, C}, {B, C}, {B}: rates 2/3, 1, 2/3, 1/3;
+    # averaged with their tau neighbours (edges repeated): 7/9, 7/9, 2/3, 4/9 -- tau = 2 and 3 tie,
+    # and the rate itself breaks the tie: tau = 3, every map right
+    model = RatioClassifier(q_grid=(0.5,), tau_grid=HAND_TAU).fit(HAND_X, HAND_Y)
+    assert model.thresholds_ == {1: RatioThresholds(0.5, 3.0)} and model.accuracy_ == 1.0
+    assert model.surface_ == pytest.approx(np.array([[2 / 3, 1, 2 / 3, 1 / 3]]))
+    assert [sum(model.pooled_betti(region)[1] for region in m) for m in HAND_X] == HAND_Y
+    # C's beta_0 wrong: right at tau = 2, 3, 5, 8: {A}, {A, B}, {B}, {B}; averaged 4/9, 4/9, 4/9, 1/3:
+    # the first three tie and tau = 3 (2 of 3 right) has the highest rate
+    model.fit(HAND_X, HAND_Y, beta0_right=[True, True, False])
+    assert model.thresholds_ == {1: RatioThresholds(0.5, 3.0)} and model.accuracy_ == pytest.approx(2 / 3)
+    # q picks l_q too: with q = 0 (the shortest bar, length 1 in every window) the same tau fits
+    both = RatioClassifier(q_grid=(0.0, 0.5), tau_grid=HAND_TAU).fit(HAND_X, HAND_Y)
+    assert both.surface_[0] == pytest.approx(both.surface_[1]) and both.thresholds_[1] == RatioThresholds(0.0, 3.0)
+
+
+def test_fit_follows_scikit_learn_conventions_and_checks_its_input():
+    model = RatioClassifier(pooling="median", tau_grid=HAND_TAU)
+    assert model.get_params()["pooling"] == "median" and not hasattr(model, "thresholds_")  # __init__ only stores
+    assert model.fit(HAND_X, HAND_Y) is model and model.pooling == "median"
+    assert not hasattr(clone(model), "thresholds_") and clone(model).get_params() == model.get_params()
+    with pytest.raises(SwarmtopoError, match="not fitted"):
+        RatioClassifier().read(HAND_X[0][0])
+    with pytest.raises(SwarmtopoError, match="one true beta_1"):
+        RatioClassifier().fit(HAND_X, HAND_Y[:2])
+    with pytest.raises(SwarmtopoError, match="one true beta_1"):
+        RatioClassifier().fit(HAND_X, HAND_Y, beta0_right=[True])
+    with pytest.raises(SwarmtopoError, match=">= 0"):
+        RatioClassifier().fit(HAND_X, [1, -1, 2])
+    with pytest.raises(SwarmtopoError, match="tau_grid"):
+        RatioClassifier(tau_grid=(3.0, 2.0)).fit(HAND_X, HAND_Y)
+    with pytest.raises(SwarmtopoError, match="q_grid"):
+        RatioClassifier(q_grid=(1.5,)).fit(HAND_X, HAND_Y)
+    with pytest.raises(InputError, match="pooling"):
+        RatioClassifier(pooling="max").fit(HAND_X, HAND_Y)

@@ -13,15 +13,18 @@ import shutil
 import subprocess
 import threading
 import time
+from decimal import Decimal
 
 import numpy as np
 import pytest
+from hypothesis import given, strategies as st
 
 from swarmtopo.arena import default_arena
 from swarmtopo.log import EncounterLog, state_labels
-from swarmtopo.pipeline.map import MapConfig, map_encounters
+from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.viz.report import write_map_outputs
-from swarmtopo.viz.report_html import MAX_ANIMATION_AGENTS, percent, script_json
+from swarmtopo.viz.report_html import MAX_ANIMATION_AGENTS, script_json
+from swarmtopo.viz.text import format_confidence
 from swarmtopo.sim import simulate
 
 EVIL = "<script>alert(1)</script>"
@@ -98,14 +101,26 @@ def test_verdict_numbers_equal_map_json(demo):
     assert len(confidence) == len(doc["confidence"])
     for e in confidence:
         expected = doc["confidence"][e["dim"]]
-        assert float(e["value"]) == expected and e["text"] == percent(expected)
+        assert float(e["value"]) == expected and e["text"] == format_confidence(expected)
     true_betti = {int(e["dim"]): int(e["value"]) for e in _attr_values(page, "true-betti")}
     assert true_betti == dict(enumerate(demo["arena"].betti)) == {0: 1, 1: 1}
 
 
-def test_percent_format():
-    assert percent(0.3618177769791703) == "36.2%"
-    assert percent(1.0) == "100.0%"
+def test_confidence_format_never_rounds_to_certainty_or_to_zero():
+    cases = {0.3618177769791703: "36.2%", 1.0: "100.0%", 0.0: "0.0%", 0.99949: "99.9%", 0.99996: "99.996%",
+             0.9995: "99.95%",  # the float 0.9995 is 0.99950000000000005...: 100.0% at one decimal
+             1e-5: "0.001%", 0.0004: "0.04%", 1 - 2 ** -53: "99.99999999999999%"}
+    assert {p: format_confidence(p) for p in cases} == cases
+
+
+@given(st.floats(0, 1, exclude_min=True, exclude_max=True))
+def test_confidence_format_is_the_nearest_strictly_inside_0_and_100(p):
+    text = format_confidence(p)
+    assert text.endswith("%")
+    shown = Decimal(text[:-1])
+    places = -shown.as_tuple().exponent
+    assert 0 < shown < 100 and places >= 1
+    assert abs(shown - Decimal(p) * 100) <= Decimal(5) / 10 ** (places + 1)
 
 
 def test_thresholds_and_timings_equal_map_json(demo):
@@ -187,6 +202,8 @@ def test_animation_is_subsampled_true_positions(demo):
     swarm = fig["frames"][0]["traces"][0]
     agents = fig["data"][swarm]["text"]
     assert len(agents) == MAX_ANIMATION_AGENTS < 200
+    # the note says the swarm's size and that the picture shows a share of it
+    assert f"{MAX_ANIMATION_AGENTS} of the 200 agents at 31 sampled times (evenly spaced)" in demo["html"]
     # Frame k, point j is agent agents[j] at times[k].
     k, j = 7, 5
     agent = int(agents[j].split()[-1])
@@ -418,7 +435,7 @@ def test_report_renders_in_headless_chromium(demo, evil, tmp_path):
     doc = demo["map"]
     verdict = page["probe"]["verdict"]
     for n, b in doc["betti"].items():
-        assert f"β{n} = {b} ({percent(doc['confidence'][n])} confidence)" in verdict
+        assert f"β{n} = {b} ({format_confidence(doc['confidence'][n])} confidence)" in verdict
     assert "true (from the arena): β0 = 1, β1 = 1" in verdict
     assert hostile["dialogs"] == []
     assert EVIL in hostile["probe"]["text"] and EVIL_IMG in hostile["probe"]["text"]  # shown as text
@@ -427,10 +444,11 @@ def test_report_renders_in_headless_chromium(demo, evil, tmp_path):
 def test_a_contact_trace_report_speaks_of_contact_loops_not_obstacles(demo):
     from swarmtopo.experiments.sweep import contact_trace
     from swarmtopo.viz.report_html import report_html
+    from swarmtopo.viz.summary import map_json
 
     log = contact_trace(demo["sim"].log)
     tmap = map_encounters(log, MapConfig(seed=0, embed_dim=2, cycles=False))
-    assert tmap.to_json()["log"]["contact_trace"] is True
+    assert map_json(tmap)["log"]["contact_trace"] is True
     page = report_html(tmap, log=log)
     assert "loops of the contact graph" in page and "(obstacles)" not in page
     assert "A loop of the contact graph shows as a loop" in page and "A hole in the arena" not in page

@@ -16,7 +16,8 @@ from swarmtopo.experiments import reproduce as rp
 from swarmtopo.metric.graph import build_graph
 from swarmtopo.metric.landmarks import maxmin
 from swarmtopo.topology.persistence import Diagram, rips_persistence, snr
-from swarmtopo.pipeline.map import WHOLE_LOG, MapConfig, map_encounters
+from swarmtopo.pipeline.config import WHOLE_LOG
+from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.viz.plots import cyclic_colors, new_figure, plot_bar_separation, plot_distributions
 from swarmtopo.sim import simulate
 

@@ -9,8 +9,7 @@ from shapely.geometry import Polygon, box
 
 import swarmtopo
 from swarmtopo import Arena, InputError
-from swarmtopo.io.logs import LOG_FORMAT
-from swarmtopo.log import RW, S, WF
+from swarmtopo.log import LOG_FORMAT, RW, S, WF
 from swarmtopo.sim import Command, MotionParams, SensingParams, interpreted_kernels, simulate
 
 DT = 0.1
@@ -185,11 +184,12 @@ def test_progress_is_reported_about_a_hundred_times():
     [
         (dict(dt=0.6), "r_d / 4"),
         (dict(dt=0.0), "dt must be a positive finite number"),
-        (dict(duration=math.nan), "duration must be a finite number >= 0"),
+        (dict(duration=math.nan), "duration must be a positive finite number"),
         (dict(static_time=-1.0), "static_time must be a finite number >= 0"),
         (dict(n_agents=2.0), "n_agents must be a positive integer"),
         (dict(n_agents=0), "n_agents"),
-        (dict(duration=-1.0), ">= 0"),
+        (dict(duration=-1.0), "duration must be a positive finite number"),
+        (dict(duration=0.0), "duration must be a positive finite number"),
         (dict(static_fraction=1.5), "static_fraction"),
         (dict(commands=[Command(1.0, "S", agents=(99,))]), "agents are 0..9"),
         (dict(trajectory_every=0.0), "trajectory_every"),
@@ -227,18 +227,18 @@ def test_invalid_parameter_objects_raise(make, message):
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    # duration 1.04 s at dt 0.1 s: K = 10 steps, the last at t = 1.0 s
+    # duration 1 s at dt 0.1 s: K = 10 steps, the last at t = 1.0 s
     (dict(static_fraction=0.5, static_time=1.04), "static_time is after the run ends at t = 1 s"),
     (dict(commands=[Command(1.0, "S", agents=(0,)), Command(2.5, "free", fraction=1.0)]),
      "command 'free' at t = 2.5 s comes after the run ends at t = 1 s"),
 ])
 def test_commands_after_the_end_are_refused(kwargs, message):
     with pytest.raises(InputError, match=re.escape(message)):
-        simulate(Arena(box(0, 0, 100, 100)), 4, 1.04, rng=0, **kwargs)
+        simulate(Arena(box(0, 0, 100, 100)), 4, 1.0, rng=0, **kwargs)
 
 
 def test_commands_at_the_last_step_are_applied():
-    log = simulate(Arena(box(0, 0, 100, 100)), 4, 1.04, rng=0, static_fraction=0.5, static_time=1.0).log
+    log = simulate(Arena(box(0, 0, 100, 100)), 4, 1.0, rng=0, static_fraction=0.5, static_time=1.0).log
     assert log.static_time.tolist() == [1.0, 1.0]
     # a static_time after the end is harmless when nobody is made static
     assert simulate(Arena(box(0, 0, 100, 100)), 4, 1.0, rng=0, static_time=5.0).log.n_agents == 4
@@ -248,3 +248,21 @@ def test_resolution_rule_message_names_the_largest_valid_dt():
     with pytest.raises(InputError) as err:
         simulate(Arena(box(0, 0, 100, 100)), 5, 1.0, dt=1.0)
     assert "use dt <= 0.5 s" in str(err.value)
+
+
+@pytest.mark.parametrize("duration, dt, nearest", [
+    (0.1, 0.5, "use 0.5 s"),  # would be K = 0 steps: a log of t = 0 only
+    (1.0, 0.3, "use 0.9 s or 1.2 s"),  # would be 0.9 s without a word
+    (20.05, 0.1, "use 20 s or 20.1 s"),
+])
+def test_a_duration_must_be_a_whole_number_of_time_steps(duration, dt, nearest):
+    with pytest.raises(InputError) as info:
+        simulate(Arena(box(0, 0, 100, 100)), 4, duration, dt=dt)
+    assert str(info.value) == (f"duration {duration:g} s is not a whole number of time steps dt = {dt:g} s "
+                               f"({duration / dt:.6g} steps); {nearest}")
+
+
+def test_a_duration_within_a_relative_1e_9_of_whole_steps_is_that_many_steps():
+    # 0.9 / 0.3 = 3.0000000000000004 and 30 / 0.1 = 299.99999999999994 steps
+    for duration, dt in ((0.9, 0.3), (30.0, 0.1), (1.0 + 1e-10, 0.1)):
+        assert simulate(Arena(box(0, 0, 100, 100)), 4, duration, dt=dt).log.meta["duration"] == round(duration, 9)

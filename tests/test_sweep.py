@@ -24,7 +24,7 @@ from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.experiments.grid import PARAMS, STORE_INT_MAX, expand_grid, read_sweep
 from swarmtopo.experiments.store import RUN_COLUMNS, ResultStore, read_jobs
 from swarmtopo.experiments.sweep import job_map_config, run_job, run_sweep
-from swarmtopo.pipeline.map import MapConfig
+from swarmtopo.pipeline import MapConfig
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "sweep-small.toml"
 
@@ -189,10 +189,12 @@ def test_keys_are_the_same_in_another_process():
     ("[swarm]\nstatic_fraction = 1.5", ["[swarm] static_fraction = 1.5", "<= 1"]),
     ("[swarm]\nstatic_fraction = 0.1\nstatic_time = 30",
      ["[swarm] static_fraction = 0.1, static_time = 30.0: static_time is after the run ends at t = 20 s"]),
-    # the simulator's own check: 10.04 s is 100 steps of 0.1 s, so the run ends at t = 10 s
-    ("[swarm]\nduration = 10.04\nstatic_fraction = 0.3\nstatic_time = 10.04",
-     ["[swarm] duration = 10.04, static_fraction = 0.3, static_time = 10.04: static_time is after the run "
+    # the simulator's own checks: the run ends at t = 10 s; 10.04 s is no whole number of 0.1 s steps
+    ("[swarm]\nduration = 10\nstatic_fraction = 0.3\nstatic_time = 10.04",
+     ["[swarm] duration = 10.0, static_fraction = 0.3, static_time = 10.04: static_time is after the run "
       "ends at t = 10 s"]),
+    ("[swarm]\nduration = 10.04", ["[swarm] duration = 10.04: duration 10.04 s is not a whole number of time steps "
+                                   "dt = 0.1 s (100.4 steps); use 10 s or 10.1 s"]),
     ("[swarm]\nduration = [30, 10]\nstatic_fraction = 0.5\nstatic_time = 20",
      ["[swarm] duration = 10.0, static_fraction = 0.5, static_time = 20.0", "run ends at t = 10 s"]),
     # integers must fit the store's 32-bit columns
@@ -235,6 +237,8 @@ def test_keys_are_the_same_in_another_process():
     ("[sweep]\nseed = 3", ["[sweep] seed: unknown key"]),
     ("map = 3", ["[map]: expected a table"]),
     ("[map\nmetric = 1", ["invalid TOML", "line 1"]),
+    *((body, ["no key in [arena], [swarm] or [map]: nothing to sweep"])
+      for body in ("", "# a comment", "[sweep]\nreplicates = 3\n[swarm]\n[map]")),
 ])
 def test_malformed_file_is_one_error_naming_file_key_and_value(tmp_path, body, fragments):
     path = tmp_path / "bad.toml"
@@ -298,7 +302,7 @@ def test_input_files_enter_the_key_by_content_and_reach_the_job(tmp_path):
 
     from swarmtopo.arena import square_arena
     from swarmtopo.readers.paper import BettiClassifier
-    from swarmtopo.io.logs import write_arena
+    from swarmtopo.io import write_arena
 
     write_arena(square_arena(400.0, [shapely.box(150, 150, 250, 250)]), tmp_path / "room.geojson")
     BettiClassifier.from_theta({1: (0.5, 0.0, 1e9)}, {"name": "blind"}).save(tmp_path / "theta.json")  # no hole

@@ -6,12 +6,12 @@ import dataclasses
 import numpy as np
 import pytest
 
-from tuning import (A_GRID, B_GRID, Q_GRID, TAU_GRID, TuningMap, calibrated_classifier,
-                                         cross_fitted_features, cross_validated, exact, features_under, fit_gate,
-                                         fit_regions_exponent, fit_thresholds, maps_from_rows, fit_veto, gate_estimates,
-                                         grid_estimates, regions_exponent_scores, several_region_products)
+from tuning import (TuningMap, calibrated_classifier, cross_fitted_features, cross_validated, exact, features_under,
+                    fit_regions_exponent, fit_thresholds, maps_from_rows, regions_exponent_scores,
+                    several_region_products, training_set)
+from swarmtopo.readers.ratio import (CONFIDENCE_FEATURES, Q_GRID, REGIONS_EXPONENT, TAU_GRID, RatioClassifier,
+                                     RatioThresholds, grid_estimates, map_confidence)
 from swarmtopo.topology.persistence import Diagram
-from swarmtopo.readers.ratio import CONFIDENCE_FEATURES, REGIONS_EXPONENT, RatioClassifier, RatioThresholds, map_confidence
 
 
 def window(holes, rng):
@@ -55,7 +55,7 @@ def test_vectorised_grid_equals_the_literal_classifier():
     maps.append(TuningMap(regions=(odd, maps[0].regions[0]), est_betti0=2, true_betti0=2, true_betti1=2, cell="c"))
     truth = np.array([m.true_betti1 for m in maps])
     for pooling in ("mean", "median"):
-        est = grid_estimates(maps, pooling)
+        est = grid_estimates(training_set(maps)[0], pooling)
         for i, q in enumerate(Q_GRID):
             for j in range(0, len(TAU_GRID), 7):
                 literal = exact(maps, RatioThresholds(q, TAU_GRID[j]), pooling)
@@ -79,7 +79,7 @@ def test_calibration_grid_maps_join_the_cross_fitted_ones_read_with_the_final_th
     th = fit_thresholds(maps).thresholds
     features, correct = features_under(grid, th)
     assert len(features) == 7 and correct == [False] + [True] * 6
-    assert features[0] == RatioClassifier({1: th}).region_features(grid[0].regions[0], 1)
+    assert features[0] == RatioClassifier.from_thresholds({1: th}).region_features(grid[0].regions[0], 1)
     model = calibrated_classifier(maps, th, provenance={"name": "t"}, folds=3, beyond=grid)
     assert model.provenance_["calibration"] == "3-fold cross-fitted on 30 tuning maps and 7 calibration-grid maps"
     assert model.calibration_["1"]["maps"] == 37
@@ -175,74 +175,9 @@ def test_cross_fitted_features_read_each_one_region_map_with_thresholds_fitted_w
     order = [i for k in range(3) for i in range(len(single)) if i % 3 == k]
     for pos, i in enumerate(order):
         th = fit_thresholds([m for j, m in enumerate(single) if j % 3 != i % 3]).thresholds
-        assert features[pos] == RatioClassifier({1: th}).region_features(single[i].regions[0], 1)
+        assert features[pos] == RatioClassifier.from_thresholds({1: th}).region_features(single[i].regions[0], 1)
         assert correct[pos] == bool(exact([single[i]], th)[0])
     assert correct[order.index(3)] is False
-
-
-def gated_maps(n, rng):
-    """One-region maps whose true holes agree (A = 0.9) and whose one noise loop, about
-    6.5-7 times the median noise length (score about ln 6.5-7, just above a = 1.84),
-    does not (A = 0.4)."""
-    maps = []
-    for _ in range(n):
-        holes = int(rng.integers(0, 4))
-        windows = []
-        for _ in range(3):
-            noise = [[b, b + rng.uniform(0.9, 1.1)] for b in rng.uniform(1, 2, 10)]
-            signal = [[1.0, 1.0 + rng.uniform(8, 12)] for _ in range(holes)]
-            fake = [[1.0, 1.0 + rng.uniform(6.5, 7.0)]]  # scores about ln 6.5-7: above a = 1.84 and below 2
-            windows.append(Diagram(pairs=(np.array([[0.0, np.inf]]), np.array(noise + signal + fake)),
-                                   backend="test"))
-        agreement = np.r_[np.full(holes, 0.9), 0.4, np.full(4, 0.2)][:5]
-        maps.append(TuningMap(regions=(tuple(windows),), est_betti0=1, true_betti0=1, true_betti1=holes, cell="c",
-                              agreement=(agreement,)))
-    return maps
-
-
-def test_vectorised_gate_grid_equals_the_literal_gated_classifier():
-    rng = np.random.default_rng(5)
-    maps = gated_maps(10, rng)
-    single = synthetic_maps(1, rng)[0]  # a region without overlapping windows: NaN agreement vetoes nothing
-    maps.append(dataclasses.replace(single, agreement=(np.full(5, np.nan),)))
-    truth = np.array([m.true_betti1 for m in maps])
-    est = gate_estimates(maps, 0.5)
-    for i in range(0, len(A_GRID), 4):
-        for j in range(0, len(B_GRID), 6):
-            th = RatioThresholds(0.5, float(np.exp(A_GRID[i])), B_GRID[j])
-            literal = exact(maps, th)
-            assert np.array_equal(literal, est[:, i, j] == truth), (A_GRID[i], B_GRID[j])
-            model = RatioClassifier({1: th})
-            counts = [model.with_agreement(m.regions[0], m.agreement[0]).pooled_betti(m.regions[0])[1] for m in maps]
-            assert counts == list(est[:, i, j]), (A_GRID[i], B_GRID[j])
-
-
-def test_the_gate_fit_vetoes_the_disagreeing_loop_the_score_alone_counts():
-    maps = gated_maps(30, np.random.default_rng(6))
-    gate = fit_gate(maps, 0.5)
-    assert exact(maps, gate).all() and 0.4 <= gate.agreement < 0.9
-    # the score alone cannot tell the loop of ln 6.5-7 from the holes of ln 8-12 at a low threshold
-    assert not exact(maps, RatioThresholds(0.5, float(np.exp(1.84)))).all()
-    # maps stored without A_k cannot be read by a gate that needs them
-    bare = [dataclasses.replace(m, agreement=()) for m in maps]
-    with pytest.raises(ValueError, match="agreement='always'"):
-        gate_estimates(bare, 0.5)
-
-
-def test_the_veto_fit_keeps_the_score_threshold_and_takes_the_strongest_veto_that_breaks_no_map():
-    maps = gated_maps(30, np.random.default_rng(7))
-    score_only = RatioThresholds(0.5, float(np.exp(1.84)))
-    assert not exact(maps, score_only).any()  # every map counts the loop of ln 6.5-7 (A = 0.4) as a hole
-    veto = fit_veto(maps, score_only)
-    assert (veto.q, veto.tau) == (score_only.q, score_only.tau)
-    # from b = 0.4 the loop is vetoed; every hole has A = 0.9, so b stops just below it
-    assert exact(maps, veto).all() and veto.agreement == 0.88
-    assert not exact(maps, dataclasses.replace(veto, agreement=0.9)).all()
-    # a veto that breaks a map is not taken, whatever it fixes elsewhere: here the loop of
-    # A = 0.4 is a true hole of one map, right by the score alone
-    cost = dataclasses.replace(maps[0], true_betti1=maps[0].true_betti1 + 1)
-    assert exact([cost], score_only).all()
-    assert fit_veto(maps + [cost], score_only).agreement == 0.38
 
 
 def test_maps_know_their_regions_spans_and_their_features_carry_the_span():
@@ -255,5 +190,5 @@ def test_maps_know_their_regions_spans_and_their_features_carry_the_span():
     assert read.spans == (35.0,) and len(read.regions) == 1 and len(read.regions[0]) == 6
     th = RatioThresholds(0.5, 3.0)
     (features,), _ = features_under([read], th)
-    assert features == RatioClassifier({1: th}).region_features(read.regions[0], 1, span=35.0)
+    assert features == RatioClassifier.from_thresholds({1: th}).region_features(read.regions[0], 1, span=35.0)
     assert features["log_span"] == pytest.approx(np.log(35.0))

@@ -1,12 +1,31 @@
 """swarmtopo: topological maps of unknown arenas from who-met-whom-when.
 
-Pipeline (one module per stage)::
+A swarm of agents that cannot localize themselves reports encounter events
+``[t, a, b]`` and status changes; swarmtopo recovers the arena's Betti numbers
+(beta_0 regions, beta_1 holes) with a confidence, and pictures to check them.
 
-    Arena --sim.simulate--> EncounterLog --graph--> EncounterGraph --landmarks-->
-    L x L distances --persistence--> Diagram --classify--> TopologicalMap
-                                         \\--embed (MDS)--> pictures
+>>> import swarmtopo as st
+>>> arena = st.random_arena(2, rng=1)                       # doctest: +SKIP
+>>> sim = st.simulate(arena, n_agents=200, duration=30.0, rng=1)
+>>> tmap = st.map_encounters(sim.log)
+>>> tmap.betti, tmap.confidence
+
+The public names (loaded on first use, so ``import swarmtopo`` stays light):
+
+``simulate``         run the bio-inspired swarm in an arena -> ``Simulation`` (``.log``)
+``read_log``         a log folder (events.csv|parquet, status, meta.json) -> ``EncounterLog``
+``read_trace``       a proximity trace (CSV/Parquet, SocioPatterns, ONE) -> ``(EncounterLog, report)``
+``map_encounters``   ``EncounterLog`` -> ``TopologicalMap`` (Betti numbers, confidence, diagrams)
+``MapConfig``        the pipeline's options; ``config_from_options`` parses them as users write them
+``TopologicalMap``   the result; ``map_json`` gives its map.json document
+``write_map``        map.json, report.html and figures into a folder
+``Arena``            free space as polygons; ``random_arena``, ``default_arena``, ``read_arena``
+``EncounterLog``     the events a base station receives
+``load_classifier``  a Betti reader by preset name (default, trace, paper) or file
+``SwarmtopoError``, ``InputError``, ``ArenaError``   what bad input raises
 """
 
+from importlib import import_module
 from importlib.metadata import PackageNotFoundError, version
 
 try:
@@ -14,8 +33,40 @@ try:
 except PackageNotFoundError:  # running from a source tree without install
     __version__ = "0.0.0+unknown"
 
-from .arena import Arena
-from .errors import ArenaError, InputError, SwarmtopoError
-from .log import EncounterLog
+_PUBLIC = {
+    "simulate": "swarmtopo.sim",
+    "Simulation": "swarmtopo.sim",
+    "read_log": "swarmtopo.io",
+    "read_trace": "swarmtopo.io",
+    "read_arena": "swarmtopo.io",
+    "map_encounters": "swarmtopo.pipeline",
+    "MapConfig": "swarmtopo.pipeline",
+    "config_from_options": "swarmtopo.pipeline",
+    "TopologicalMap": "swarmtopo.pipeline",
+    "map_json": "swarmtopo.viz.summary",
+    "write_map": "swarmtopo.viz.report",
+    "Arena": "swarmtopo.arena",
+    "random_arena": "swarmtopo.arena",
+    "default_arena": "swarmtopo.arena",
+    "EncounterLog": "swarmtopo.log",
+    "load_classifier": "swarmtopo.readers.registry",
+    "SwarmtopoError": "swarmtopo.errors",
+    "InputError": "swarmtopo.errors",
+    "ArenaError": "swarmtopo.errors",
+}
+_RENAMED = {"write_map": "write_map_outputs"}
 
-__all__ = ["Arena", "ArenaError", "EncounterLog", "InputError", "SwarmtopoError", "__version__"]
+__all__ = sorted(_PUBLIC) + ["__version__"]
+
+
+def __getattr__(name: str):
+    """Load a public name on first use (PEP 562)."""
+    if name not in _PUBLIC:
+        raise AttributeError(f"module 'swarmtopo' has no attribute {name!r}")
+    value = getattr(import_module(_PUBLIC[name]), _RENAMED.get(name, name))
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return __all__

@@ -620,6 +620,8 @@ def _clean_ring(ring: LinearRing, where: str, source) -> LinearRing:
         xy = xy[np.r_[True, np.any(np.diff(xy, axis=0) != 0, axis=1)]]
     if len(xy) < 4:
         raise ArenaError(f"{where} has fewer than 3 distinct corners", file=source)
+    if shapely.MultiPoint(xy).convex_hull.geom_type != "Polygon":
+        raise ArenaError(f"{where} has zero area: its corners are collinear, it encloses no area", file=source)
     clean = LinearRing(xy)
     if not clean.is_simple:
         bad = shapely.validation.explain_validity(Polygon(clean))

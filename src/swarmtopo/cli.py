@@ -18,10 +18,33 @@ import typer
 from typer.exceptions import TyperException
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+from typer.core import TyperGroup
 
+from . import __version__
 from .errors import SwarmtopoError
+from .io import output
+
+
+class _Interrupt(Exception):
+    """Ctrl-C in a command, as the one line to print (Typer would turn a KeyboardInterrupt
+    into a silent exit 130)."""
+
+
+class _Commands(TyperGroup):
+    def invoke(self, ctx):
+        done = len(output.COMMITTED)
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt as exc:
+            written = output.COMMITTED[done:]
+            message = (exc.message if isinstance(exc, output.Interrupted) else
+                       f"interrupted after writing {', '.join(map(str, written))}" if written else
+                       "interrupted: nothing written")
+            raise _Interrupt(message) from None
+
 
 app = typer.Typer(
+    cls=_Commands,
     add_completion=False,
     no_args_is_help=True,
     pretty_exceptions_show_locals=False,
@@ -29,39 +52,50 @@ app = typer.Typer(
 )
 out = Console()
 err = Console(stderr=True)
-MAX_LANDMARKS_OPTION = 2000
-"""Most landmarks --landmarks may ask for per window (800 took about 1 GB and 80 s per window on a trace)."""
 DEMO_AGENTS, DEMO_SECONDS = 200, 30.0
 """The demo's swarm: the accuracy benchmark's smallest budget."""
 DEMO_WRITER = "swarmtopo demo"
 """``written_by`` in the meta.json of the demo's log: the only log demo may replace."""
 MAX_SCALE = 1000.0
 """Largest --scale: a 500 m square random arena, beyond what the wall grid accepts at r_d = 30 mm."""
-MIN_WINDOW_SCALE = 0.05
-"""Least --window-scales multiplier: windows of one encounter per agent at the automatic length."""
 VERBOSE_HELP = "Also report each stage's details and timings on stderr (in pipes too)."
 
 
-OVERWRITE_HELP = "Replace the log already in --out (its log files are replaced or removed)."
+OVERWRITE_HELP = "Replace the log already in --out (its log files are replaced or removed; other files stay)."
 
 
-def _write_log_folder(log, out_dir: Path, quiet: bool, overwrite: bool, protect=(), **options) -> list[Path]:
-    """``io.write_log`` into a folder without a log, or over one with ``overwrite``,
-    saying which outdated log files of the folder it removed; never over a file of
-    ``protect`` (the trace an ingest reads)."""
-    from .io.logs import log_files, refuse_protected, write_log
+@contextmanager
+def _staged_log(out_dir: Path, overwrite: bool, protect=()):
+    """Stage a log folder for ``out_dir`` (``output.staged_folder``, owning the log files
+    there): refused if it holds a log and not ``overwrite``, or if the new log would
+    replace or delete a file of ``protect`` (the trace an ingest reads)."""
+    from .io.logs import log_files, refuse_protected
 
     refuse_protected(out_dir, protect)  # before --overwrite could be suggested
-    before = set(log_files(out_dir))
-    if before and not overwrite:
-        names = ", ".join(sorted(p.name for p in before))
-        raise SwarmtopoError(f"{out_dir}: already holds a log ({names}); pass --overwrite to replace it, "
-                             f"or choose another --out")
-    written = write_log(log, out_dir, **options)
+    with output.staged_folder(out_dir, [p.name for p in log_files(out_dir)], what="log",
+                              overwrite=overwrite) as stage:
+        yield stage
+
+
+def _say_removed(stage, quiet: bool) -> None:
+    """Name the outdated files the new result removed (a parquet log over a CSV one)."""
     if not quiet:
-        for path in sorted(before - set(written)):
+        for path in stage.removed:
             out.print(f"removed the outdated {path}", markup=False, highlight=False, soft_wrap=True)
-    return written
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        out.print(f"swarmtopo {__version__}", markup=False, highlight=False)
+        raise typer.Exit()
+
+
+@app.callback()
+def _main_options(
+    version: bool = typer.Option(False, "--version", is_eager=True, callback=_print_version,
+                                 help="Print swarmtopo's version and exit."),
+) -> None:
+    pass
 
 
 def _check_verbosity(quiet: bool, verbose: bool) -> None:
@@ -145,7 +179,8 @@ def simulate(
                                 help="Scale factor of every length of the arena (random or --arena)."),
     agents: int = typer.Option(200, "--agents", min=1, callback=_agents_option,
                                help="Swarm size N (at most 100,000; agents x duration / dt at most 1e10)."),
-    duration: float = typer.Option(20.0, "--duration", min=0.0, callback=_finite_option, help="Seconds of data."),
+    duration: float = typer.Option(20.0, "--duration", callback=_positive_option,
+                                   help="Seconds of data: a whole number of time steps --dt."),
     seed: int = typer.Option(0, "--seed", min=0, help="Random seed (same seed, same bytes)."),
     static_fraction: float = typer.Option(0.0, "--static-fraction", min=0.0, max=1.0,
                                           help="Hybrid network: fraction of agents stopped for good."),
@@ -165,9 +200,11 @@ def simulate(
     import time
 
     from .arena import random_arena
-    from .io.logs import read_arena
+    from .io.arenas import read_arena
+    from .io.logs import write_log
     from .sim import (MotionParams, SensingParams, check_run_size, check_static_time, check_time_step,
                       simulate as run)
+    from .sim.simulate import check_duration
 
     _check_verbosity(quiet, verbose)
     if arena is not None and holes is not None:
@@ -176,6 +213,7 @@ def simulate(
         raise typer.BadParameter("the static agents' stop time needs --static-fraction > 0", param_hint="--static-time")
     _check_option("--dt", check_time_step, dt, MotionParams(), SensingParams(r_d=rd))  # the motion simulate runs with
     _check_option("--agents, --duration, --dt", check_run_size, agents, duration, dt)
+    _check_option("--duration, --dt", check_duration, duration, dt)
     _check_option("--static-time", check_static_time, static_fraction, static_time, duration, dt)
 
     if arena:  # scaled like a sweep's file arena
@@ -190,20 +228,22 @@ def simulate(
         _detail(f"arena: {world.betti[0]} region(s), {world.betti[1]} hole(s), area {world.area:.0f} mm^2; "
                 f"{agents} agents, {duration:g} s, dt {dt:g} s, r_d {rd:g} mm, seed {seed}")
     start = time.perf_counter()
-    with _progress("simulating", quiet) as tick:
-        sim = run(world, agents, duration, dt=dt, sensing=SensingParams(r_d=rd), rng=seed,
-                  static_fraction=static_fraction, static_time=static_time, truth=truth,
-                  trajectory_every=trajectories, progress=tick)
-    if verbose:
-        _detail(f"simulated in {time.perf_counter() - start:.2f} s: {sim.log.n_events} encounters, "
-                f"{len(sim.log.status_t)} status changes")
-    written = _write_log_folder(sim.log, out_dir, quiet, overwrite, fmt=fmt, truth=sim.truth,
-                                trajectories=sim.trajectories, arena=world)
+    with _staged_log(out_dir, overwrite) as stage:
+        with _progress("simulating", quiet) as tick:
+            sim = run(world, agents, duration, dt=dt, sensing=SensingParams(r_d=rd), rng=seed,
+                      static_fraction=static_fraction, static_time=static_time, truth=truth,
+                      trajectory_every=trajectories, progress=tick)
+        if verbose:
+            _detail(f"simulated in {time.perf_counter() - start:.2f} s: {sim.log.n_events} encounters, "
+                    f"{len(sim.log.status_t)} status changes")
+        written = [stage.final_path(p) for p in write_log(sim.log, stage.path, fmt=fmt, truth=sim.truth,
+                                                           trajectories=sim.trajectories, arena=world)]
+    _say_removed(stage, quiet)
     if not quiet:
         b0, b1 = world.betti
         out.print(f"{sim.log.n_events} encounters of {agents} agents over {sim.log.meta['duration']:g} s "
                   f"in an arena with {b0} region(s) and {b1} hole(s)")
-        out.print(f"wrote {', '.join(str(p) for p in written)}")
+        out.print(f"wrote {', '.join(str(p) for p in written)}", markup=False, highlight=False, soft_wrap=True)
 
 
 @app.command(epilog="Example: swarmtopo ingest primaryschool.csv --format sociopatterns --out runs/school "
@@ -229,8 +269,13 @@ def ingest(
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
-    """Convert a proximity trace into an encounter log folder (see docs/real-data.md)."""
-    from .io.traces import FORMATS, SOCIOPATTERNS_WINDOW, ingest as read_trace
+    """Convert a proximity trace into an encounter log folder.
+
+    What a contact trace can and cannot tell about its space: see the project's
+    documentation, docs/real-data.md in the source repository.
+    """
+    from .io.logs import write_log
+    from .io.traces import FORMATS, SOCIOPATTERNS_WINDOW, read_trace
     from .log import exact_time
 
     _check_verbosity(quiet, verbose)
@@ -245,9 +290,11 @@ def ingest(
     if len(set(columns.values())) < 3:
         raise typer.BadParameter(f"name three different columns, not {', '.join(map(repr, columns.values()))}",
                                  param_hint="--time-column, --a-column, --b-column")
-    log, report = read_trace(trace, fmt, skip_bad=skip_bad, **columns,
-                             window=SOCIOPATTERNS_WINDOW if window is None else window)
-    written = _write_log_folder(log, out_dir, quiet, overwrite, fmt=log_fmt, protect=(trace,))
+    with _staged_log(out_dir, overwrite, protect=(trace,)) as stage:
+        log, report = read_trace(trace, fmt, skip_bad=skip_bad, **columns,
+                                 window=SOCIOPATTERNS_WINDOW if window is None else window)
+        written = [stage.final_path(p) for p in write_log(log, stage.path, fmt=log_fmt)]
+    _say_removed(stage, quiet)
     if verbose:
         _detail(f"ingest report: {report.as_meta()}")
     if not quiet:
@@ -260,234 +307,129 @@ def ingest(
         notes = ", ".join(f"{k.replace('_', ' ')}: {v}" for k, v in report.counts.items() if v)
         if notes:
             out.print(notes, markup=False, highlight=False)
-        out.print(f"wrote {', '.join(str(p) for p in written)}", markup=False, highlight=False)
+        out.print(f"wrote {', '.join(str(p) for p in written)}", markup=False, highlight=False, soft_wrap=True)
 
 
-def _parse_window(text: Optional[str]):
-    if text is None:
-        return None
-    parts = text.split(":")
-    if len(parts) != 2:
-        raise typer.BadParameter(f"{text!r} is not T0:T1 (either side may be empty)")
-    try:
-        ends = [float(p) if p.strip() else None for p in parts]
-    except ValueError:
-        raise typer.BadParameter(f"{text!r} is not T0:T1 with numbers in seconds") from None
-    if any(e is not None and math.isnan(e) for e in ends):
-        raise typer.BadParameter(f"{text!r}: a window end cannot be NaN")
-    if ends[0] == math.inf or ends[1] == -math.inf:
-        raise typer.BadParameter(f"{text!r}: a window cannot start at +inf or end at -inf (it would hold nothing)")
-    return tuple(None if e is None or math.isinf(e) else e for e in ends)
+def _map_option(name: str, metavar: str, help: str):
+    """A ``map`` option that is one ``MapConfig`` field, passed on as written: the config
+    parses and validates it (``pipeline.config.OPTIONS``)."""
+    return typer.Option(None, "--" + name.replace("_", "-"), metavar=metavar, help=help)
 
 
-def _hop_cost_option(value: Optional[float]) -> Optional[float]:
-    """A --hop-cost value: seconds in [0, MAX_HOP_COST]."""
-    from .pipeline.map import MAX_HOP_COST
-
-    if value is not None and not (math.isfinite(value) and value <= MAX_HOP_COST):
-        raise typer.BadParameter(f"{value:g} is not a number of seconds in [0, {MAX_HOP_COST:g}]")
-    return value
-
-
-def _parse_wall_follow_weight(text: Optional[str]):
-    """A --wall-follow-weight value: 'none' or a number >= 0."""
-    if text is None or text == "none":
-        return text
-    try:
-        value = float(text)
-    except ValueError:
-        raise typer.BadParameter(f"{text!r} is not a number or 'none'") from None
-    from .pipeline.map import MAX_WALL_FOLLOW_WEIGHT
-
-    if not (math.isfinite(value) and 0 <= value <= MAX_WALL_FOLLOW_WEIGHT):
-        raise typer.BadParameter(f"{text!r} must be a number in [0, {MAX_WALL_FOLLOW_WEIGHT:g}]")
-    return text
-
-
-def _parse_seconds(text: Optional[str]):
-    """A --window-length or --diffusion-time value: 'auto', 'none' or seconds > 0."""
-    if text is None or text in ("auto", "none"):
-        return text
-    try:
-        value = float(text)
-    except ValueError:
-        raise typer.BadParameter(f"{text!r} is not a number of seconds, 'auto' or 'none'") from None
-    if not (math.isfinite(value) and value > 0):
-        raise typer.BadParameter(f"{text!r} must be a positive number of seconds")
-    return text
-
-
-def _distinct_numbers(text: str, example: str) -> tuple[float, ...]:
-    """Comma-separated distinct numbers (a usage error otherwise)."""
-    try:
-        numbers = tuple(float(x) for x in text.split(","))
-    except ValueError:
-        raise typer.BadParameter(f"{text!r} is not a comma-separated list of numbers (e.g. {example})") from None
-    if len(set(numbers)) < len(numbers):
-        raise typer.BadParameter(f"{text!r}: the numbers must be distinct")
-    return numbers
-
-
-def _parse_scales(text: Optional[str]):
-    """A --window-scales value: comma-separated distinct positive numbers."""
-    if text is None:
-        return None
-    scales = _distinct_numbers(text, "0.75,1,1.25")
-    if not all(math.isfinite(x) and x >= MIN_WINDOW_SCALE for x in scales):
-        raise typer.BadParameter(f"{text!r}: the scales must be distinct positive numbers, each at least "
-                                 f"{MIN_WINDOW_SCALE:g}")
-    return scales
-
-
-def _parse_bands(text: Optional[str]):
-    """A --landmark-bands value: comma-separated distinct numbers in (0, 1]."""
-    if text is None:
-        return None
-    bands = _distinct_numbers(text, "1,0.5")
-    if not all(0 < x <= 1 for x in bands):
-        raise typer.BadParameter(f"{text!r}: the bands must be distinct numbers in (0, 1]")
-    return bands
-
-
-MAP_CONFIG_OPTIONS = ("--hop-cost", "--diffusion-time", "--wall-follow-weight", "--window-length",
-                      "--window-scales", "--landmark-bands", "--max-windows")
-"""map's options whose MapConfig field (``--max-windows``: ``max_windows``) a validation message may name."""
-
-
-def in_option_terms(message: str) -> str:
-    """A MapConfig validation message in map's terms: fields named as their options
-    (MAP_CONFIG_OPTIONS), Python's None as the options' 'none'."""
-    for option in MAP_CONFIG_OPTIONS:
-        message = re.sub(rf"\b{option[2:].replace('-', '_')}\b", option, message)
-    return re.sub(r"\bNone\b", "'none'", message)
-
-
-def _parse_max_windows(text: Optional[str]):
-    """A --max-windows value: 'none' (every window) or a whole number >= 1."""
-    if text is None or text.strip().lower() == "none":
-        return None if text is None else "none"
-    try:
-        whole = int(text) >= 1
-    except ValueError:
-        whole = False
-    if not whole:
-        raise typer.BadParameter(f"{text!r} is not a whole number >= 1 or 'none'")
-    return text
+def _option_name(field: str) -> str:
+    return "--" + field.replace("_", "-")
 
 
 @app.command("map", epilog="Example: swarmtopo map runs/two-holes --out runs/two-holes/map --metric hybrid --landmarks 300")
 def map_command(
     log_dir: Path = typer.Argument(..., help="Log folder: events.csv|parquet, optional status, meta.json."),
     out_dir: Optional[Path] = typer.Option(None, "--out", help="Output folder (default: LOG_DIR/map)."),
-    metric: str = typer.Option("hybrid", "--metric", help="plain | contracted | hybrid (paper's metrics)."),
-    subsample: str = typer.Option("maxmin", "--subsample", help="maxmin | knn | probabilistic."),
-    landmarks: Optional[int] = typer.Option(
-        None, "--landmarks", min=3, max=MAX_LANDMARKS_OPTION,
-        help="Number of landmarks L per region and window (default: the fewest that meet the sampling "
-             f"guarantee, at most 400; at most {MAX_LANDMARKS_OPTION}: persistence time grows about as L^3)."),
-    window: Optional[str] = typer.Option(None, "--window", callback=_parse_window,
-                                         help="Time window T0:T1 in seconds (either end may be empty)."),
-    maxdim: int = typer.Option(1, "--maxdim", min=1, max=2, help="Highest homology dimension (1 or 2)."),
-    seed: int = typer.Option(0, "--seed", min=0, help="Seed of landmark start and MDS."),
-    hop_cost: Optional[float] = typer.Option(
-        None, "--hop-cost", min=0.0, callback=_hop_cost_option,
-        help="Per-hop cost h in seconds on the encounter graph; 0 = the paper's metric "
-             "(default: r_d / v_c from meta.json, else from the data)."),
-    diffusion_time: Optional[str] = typer.Option(
-        None, "--diffusion-time", callback=_parse_seconds,
-        help="tau in seconds: a gap of w s between an agent's encounters weighs tau (sqrt(1 + 2 w / tau) - 1), "
-             "about a random walk's displacement; 'none' = the paper's weight w; 'auto' (default) = half the mean "
-             "time between an agent's encounters."),
-    wall_follow_weight: Optional[str] = typer.Option(
-        None, "--wall-follow-weight", callback=_parse_wall_follow_weight,
-        help="Seconds charged per second an agent spent wall following (status WF) within a gap, outside the "
-             "diffusive weights: along a wall an agent walks, it does not diffuse (default 2); 'none' = like any "
-             "other time (the paper)."),
-    window_length: Optional[str] = typer.Option(
-        None, "--window-length", callback=_parse_seconds,
-        help="Seconds of the time windows whose maps are pooled; 'none' maps the whole log at once; 'auto' "
-             "(default) holds about 20 encounters per agent (20 x the mean time between an agent's encounters)."),
-    window_scales: Optional[str] = typer.Option(
-        None, "--window-scales", callback=_parse_scales,
-        help="Comma-separated multipliers of the window length, each at least 0.05: the windows of every such "
-             "length are pooled together (default: 0.75,1,1.25; 1 maps one length, about three times faster: "
-             "docs/accuracy.md)."),
-    landmark_bands: Optional[str] = typer.Option(
-        None, "--landmark-bands", callback=_parse_bands,
-        help="Comma-separated shares of each window's length: every window is mapped once per share B, its "
-             "landmarks drawn from the window's middle B x its length, and all are pooled (1: the whole window "
-             "once; unset: the bands the classifier reading the map was fitted with, 1,0.5 for the default "
-             "classifier and 1 for the others: docs/accuracy.md)."),
-    max_windows: Optional[str] = typer.Option(
-        None, "--max-windows", callback=_parse_max_windows,
-        help="Cap of the time windows mapped, all lengths together, at least one per length (default 48, more "
-             "than any benchmark map pools): a longer log maps an evenly spaced share of each length's windows, so "
-             "its time stops growing with its length; 'none' maps every window."),
-    agreement: str = typer.Option(
-        "auto", "--agreement",
-        help="When to compute each region's cross-window cycle agreement A_1..A_5 (map.json regions[].agreement: "
-             "is each of the longest loops the same loop in overlapping windows?): auto (default) where a gated "
-             "classifier (--classifier gated) needs it, always for every region, to inspect."),
+    metric: Optional[str] = _map_option("metric", "NAME", "plain | contracted | hybrid (the paper's metrics; default "
+                                                          "hybrid)."),
+    subsample: Optional[str] = _map_option("subsample", "NAME", "maxmin | knn | probabilistic (default maxmin)."),
+    landmarks: Optional[str] = _map_option(
+        "landmarks", "L", "Number of landmarks L per region and window, 3..2000 (default: the fewest that meet the "
+                          "sampling guarantee, at most 400; persistence time grows about as L^3)."),
+    window: Optional[str] = _map_option("window", "T0:T1", "Time window in seconds (either end may be empty)."),
+    maxdim: Optional[str] = _map_option("maxdim", "N", "Highest homology dimension, 1 or 2 (default 1)."),
+    seed: Optional[str] = _map_option("seed", "SEED", "Seed of the landmark start and the MDS (default 0)."),
+    hop_cost: Optional[str] = _map_option(
+        "hop_cost", "SECONDS", "Per-hop cost h in seconds on the encounter graph; 0 = the paper's metric "
+                               "(default: r_d / v_c from meta.json, else from the data)."),
+    diffusion_time: Optional[str] = _map_option(
+        "diffusion_time", "SECONDS|auto|none",
+        "tau in seconds: a gap of w s between an agent's encounters weighs tau (sqrt(1 + 2 w / tau) - 1), about a "
+        "random walk's displacement; 'none' = the paper's weight w; 'auto' (default) = half the mean time between "
+        "an agent's encounters."),
+    wall_follow_weight: Optional[str] = _map_option(
+        "wall_follow_weight", "WEIGHT|none",
+        "Seconds charged per second an agent spent wall following (status WF) within a gap, outside the diffusive "
+        "weights: along a wall an agent walks, it does not diffuse (default 2); 'none' = like any other time "
+        "(the paper)."),
+    window_length: Optional[str] = _map_option(
+        "window_length", "SECONDS|auto|none",
+        "Seconds of the time windows whose maps are pooled; 'none' maps the whole log at once; 'auto' (default) "
+        "holds about 20 encounters per agent (20 x the mean time between an agent's encounters)."),
+    window_encounters: Optional[str] = _map_option(
+        "window_encounters", "K", "Encounters per agent an automatic window holds (default 20)."),
+    window_scales: Optional[str] = _map_option(
+        "window_scales", "S,S,...",
+        "Comma-separated multipliers of the window length, each at least 0.05: the windows of every such length "
+        "are pooled together (default 0.75,1,1.25; 1 maps one length, about three times faster)."),
+    window_step: Optional[str] = _map_option(
+        "window_step", "SECONDS|auto", "Seconds between the starts of consecutive windows (default: half a window)."),
+    max_windows: Optional[str] = _map_option(
+        "max_windows", "N|none",
+        "Cap of the time windows mapped, all lengths together, at least one per length (default 48, more than any "
+        "benchmark map pools): a longer log maps an evenly spaced share of each length's windows, so its time stops "
+        "growing with its length; 'none' maps every window."),
+    landmark_bands: Optional[str] = _map_option(
+        "landmark_bands", "B,B,...|auto",
+        "Comma-separated shares of each window's length: every window is mapped once per share B, its landmarks "
+        "drawn from the window's middle B x its length, and all are pooled (1: the whole window once; 'auto' "
+        "(default): the bands the reader was fitted with, 1,0.5 for the default reader and 1 for the others)."),
+    max_landmarks: Optional[str] = _map_option(
+        "max_landmarks", "L", "Cap of the automatic landmark count per region and window, 3..2000 (default 400)."),
     classifier: Optional[str] = typer.Option(
         None, "--classifier",
-        help="Betti classifier: default (tuned on the accuracy benchmark), trace (the same tuned on its logs read "
-             "as contact traces), gated (whole-window landmarks, a score threshold gated by cross-window cycle "
-             "agreement: better than the default where agents follow walls for tens of seconds, docs/accuracy.md), "
-             "paper-form (the paper's form trained our way), paper (the paper's Theta*), or a JSON file. Unset: "
-             "default for a log with status changes, trace for one without."),
+        help="Betti reader: default (tuned on the accuracy benchmark), trace (the same tuned on its logs read as "
+             "contact traces), paper (the paper's classifier form, trained on random arenas the paper's way), or a "
+             "JSON file. Unset: default for a log with status changes, trace for one without."),
     paper: bool = typer.Option(
         False, "--paper",
-        help="Run exactly the paper's pipeline: no per-hop cost, no diffusive weights, wall following like any "
-             "time, the whole log, the paper's Theta*."),
+        help="Run the paper's pipeline: no per-hop cost, no diffusive weights, wall following like any time, the "
+             "whole log, whole-window landmarks, the paper's classifier form."),
+    overwrite: bool = typer.Option(False, "--overwrite",
+                                   help="Replace the map already in --out (its map files; other files stay)."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
     """Map an encounter log folder: Betti numbers with confidence, diagrams and pictures."""
-    from .readers.paper import load_classifier
     from .io.logs import read_log
     from .log import exact_time
-    from .pipeline.map import MapConfig, max_windows_option, seconds_option, wall_follow_option
+    from .pipeline.config import PAPER_OPTIONS, ConfigError, config_from_options
+    from .readers.registry import load_classifier
+    from .viz.report import MAP_FILES
 
     _check_verbosity(quiet, verbose)
+    options = {"metric": metric, "subsample": subsample, "landmarks": landmarks, "window": window, "maxdim": maxdim,
+               "seed": seed, "hop_cost": hop_cost, "diffusion_time": diffusion_time,
+               "wall_follow_weight": wall_follow_weight, "window_length": window_length,
+               "window_encounters": window_encounters, "window_scales": window_scales, "window_step": window_step,
+               "max_windows": max_windows, "landmark_bands": landmark_bands, "max_landmarks": max_landmarks}
     if paper:
-        given = [name for name, value in (("--hop-cost", hop_cost), ("--diffusion-time", diffusion_time),
-                                          ("--wall-follow-weight", wall_follow_weight),
-                                          ("--window-length", window_length), ("--window-scales", window_scales),
-                                          ("--landmark-bands", landmark_bands),
-                                          ("--max-windows", max_windows), ("--classifier", classifier))
-                 if value is not None]
-        if given:
-            raise typer.BadParameter(f"--paper fixes {', '.join(given)}; drop one or the other")
-        hop_cost, diffusion_time, wall_follow_weight, window_length, classifier = 0.0, "none", "none", "none", "paper"
-        window_scales, landmark_bands = (1.0,), (1.0,)
+        # the whole log at once: a window cap has nothing to cap
+        given = [_option_name(name) for name in (*PAPER_OPTIONS, "max_windows") if options[name] is not None]
+        if given or classifier is not None:
+            raise typer.BadParameter(f"--paper fixes {', '.join(given + ['--classifier'] * (classifier is not None))}; "
+                                     "drop one or the other")
+        options, classifier = {**options, **PAPER_OPTIONS}, "paper"
     out_dir = out_dir or log_dir / "map"
     if out_dir.exists() and not out_dir.is_dir():
         raise SwarmtopoError(f"{out_dir}: --out is a file; give a folder for the map's outputs")
     try:
-        config = MapConfig(metric=metric, subsample=subsample, landmarks=landmarks, window=window, maxdim=maxdim,
-                           seed=seed, hop_cost=hop_cost, diffusion_time=seconds_option(diffusion_time),
-                           wall_follow_weight=wall_follow_option(wall_follow_weight),
-                           window_length=seconds_option(window_length),
-                           window_scales=window_scales or MapConfig.window_scales,
-                           landmark_bands=landmark_bands or MapConfig.landmark_bands,
-                           max_windows=max_windows_option(max_windows), agreement=agreement).validate()
-    except SwarmtopoError as exc:  # options that do not go together: a usage error
-        raise typer.BadParameter(in_option_terms(str(exc))) from None
+        config = config_from_options(options)
+    except ConfigError as exc:  # a value out of its domain, or options that do not go together: a usage error
+        reason = re.sub(r"\bNone\b", "'none'", exc.reason)
+        raise typer.BadParameter(reason, param_hint=f"'{_option_name(exc.field)}'") from None
     model = load_classifier(classifier) if classifier else None  # None: the shipped one for the log
-    log = read_log(log_dir)
-    if verbose:
-        _detail(f"log {log_dir}: {log.n_events} encounters of {log.n_agents} agents from t = {exact_time(log.t[0])} "
-                f"to {exact_time(log.t[-1])} s")
-    tmap, written = _run_map(log, config, log_dir, out_dir, quiet, verbose, classifier=model)
+    with output.staged_folder(out_dir, MAP_FILES, what="map", overwrite=overwrite) as stage:
+        log = read_log(log_dir)
+        if verbose:
+            _detail(f"log {log_dir}: {log.n_events} encounters of {log.n_agents} agents from t = "
+                    f"{exact_time(log.t[0])} to {exact_time(log.t[-1])} s")
+        tmap, written = _run_map(log, config, log_dir, stage.path, quiet, verbose, reader=model)
     if not quiet:
         _print_verdict(tmap, truth=None)
-        out.print(f"wrote {', '.join(str(p) for p in written)}")
+        out.print(f"wrote {', '.join(str(stage.final_path(p)) for p in written)}", markup=False, highlight=False,
+                  soft_wrap=True)
 
 
 @app.command(epilog="Example: swarmtopo demo --out swarmtopo-demo")
 def demo(
     out_dir: Path = typer.Option(Path("swarmtopo-demo"), "--out",
-                                 help="Output folder (a log already in its log/ is replaced only if demo wrote it)."),
+                                 help="Output folder: the log in its log/, the map beside it (a log and map already "
+                                      "there are replaced only if demo wrote them; other files stay)."),
     seed: int = typer.Option(0, "--seed", min=0, help="Random seed."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
@@ -500,34 +442,40 @@ def demo(
     """
     from .arena import default_arena
     from .io.logs import log_files, write_log
-    from .pipeline.map import MapConfig
+    from .pipeline import MapConfig
     from .sim import simulate as run
+    from .viz.report import MAP_FILES
 
     _check_verbosity(quiet, verbose)
     log_dir = out_dir / "log"
-    foreign = [] if _demo_wrote(log_dir) else log_files(log_dir)
-    if foreign:
-        raise SwarmtopoError(f"{log_dir}: already holds a log that swarmtopo demo did not write "
-                             f"({', '.join(p.name for p in foreign)}); choose another --out")
+    if not _demo_wrote(log_dir):  # the demo replaces only its own log and map
+        for folder, what, found in ((log_dir, "log", log_files(log_dir)),
+                                    (out_dir, "map", [out_dir / n for n in MAP_FILES if (out_dir / n).exists()])):
+            if found:
+                raise SwarmtopoError(f"{folder}: already holds a {what} that swarmtopo demo did not write "
+                                     f"({', '.join(p.name for p in found)}); choose another --out")
     world = default_arena()
-    with _progress("simulating", quiet) as tick:
-        sim = run(world, DEMO_AGENTS, DEMO_SECONDS, rng=seed, truth=True, trajectory_every=0.5, progress=tick)
-    sim.log.meta["written_by"] = DEMO_WRITER
-    write_log(sim.log, log_dir, truth=sim.truth, trajectories=sim.trajectories, arena=world)
-    if verbose:
-        _detail(f"simulated: {sim.log.n_events} encounters of {DEMO_AGENTS} agents over {DEMO_SECONDS:g} s; "
-                f"log: {log_dir}")
-    tmap, written = _run_map(sim.log, MapConfig(seed=seed), log_dir, out_dir, quiet, verbose,
-                             ground_truth=(world, sim.truth, sim.trajectories))
+    owned = {"log": [p.name for p in log_files(log_dir)], **dict.fromkeys(MAP_FILES)}  # the rest of D stays
+    with output.staged_folder(out_dir, owned, what="demo", overwrite=True) as stage:
+        with _progress("simulating", quiet) as tick:
+            sim = run(world, DEMO_AGENTS, DEMO_SECONDS, rng=seed, truth=True, trajectory_every=0.5, progress=tick)
+        sim.log.meta["written_by"] = DEMO_WRITER
+        write_log(sim.log, stage.path / "log", truth=sim.truth, trajectories=sim.trajectories, arena=world)
+        if verbose:
+            _detail(f"simulated: {sim.log.n_events} encounters of {DEMO_AGENTS} agents over {DEMO_SECONDS:g} s; "
+                    f"log: {log_dir}")
+        tmap, written = _run_map(sim.log, MapConfig(seed=seed), log_dir, stage.path, quiet, verbose,
+                                 ground_truth=(world, sim.truth, sim.trajectories))
     if not quiet:
         _print_verdict(tmap, truth=world.betti)
-        out.print(f"log: {log_dir}")
-        out.print(f"wrote {', '.join(str(p) for p in written)}")
+        out.print(f"log: {log_dir}", markup=False, highlight=False, soft_wrap=True)
+        out.print(f"wrote {', '.join(str(stage.final_path(p)) for p in written)}", markup=False, highlight=False,
+                  soft_wrap=True)
 
 
 def _demo_wrote(log_dir: Path) -> bool:
     """Whether ``log_dir``'s meta.json says ``swarmtopo demo`` wrote the log (so it may replace it)."""
-    from .io.logs import read_json
+    from ._json import read_json
 
     meta = log_dir / "meta.json"
     try:
@@ -619,7 +567,8 @@ def reproduce(
 ) -> None:
     """Reproduce one of the paper's experiments: PNG figures, NAME.csv (one row per run),
     NAME.md (summary table) and NAME.json (summary and settings) in the output folder."""
-    from .experiments.reproduce import REPRODUCTIONS, reproduce as run
+    from .experiments.reproduce import REPRODUCTIONS, output_names, reproduce as run
+    from .io.logs import make_folder
 
     _check_verbosity(quiet, verbose)
     if name not in REPRODUCTIONS:
@@ -627,13 +576,20 @@ def reproduce(
     if name != "clust" and (workers is not None or scheduler is not None):
         raise typer.BadParameter("--workers and --scheduler apply to clust only (the others run in this process)")
     out_dir = out_dir or Path("reproduction") / name
-    options = {"workers": workers, "scheduler": scheduler} if name == "clust" else {}
-    with _sweep_progress(quiet, verbose, label=name) as tick:
-        result = run(name, out_dir, runs=runs, progress=tick, **options)
+    options, note = {}, None
+    if name == "clust":  # its resumable store lives in the folder itself, outside the staged outputs
+        make_folder(out_dir)
+        options = {"workers": workers, "scheduler": scheduler, "store": out_dir / "clust.duckdb"}
+        note = f"finished sweep jobs are saved in {options['store']}; run the same command again to run the rest"
+    with output.staged_folder(out_dir, output_names(name), what=f"{name} reproduction", overwrite=True,
+                              note=note) as stage:
+        with _sweep_progress(quiet, verbose, label=name) as tick:
+            result = run(name, stage.path, runs=runs, progress=tick, **options)
     if not quiet:
         out.print(result.table_markdown, markup=False, highlight=False)
-        written = [*result.figures, result.table, out_dir / f"{name}.md", out_dir / f"{name}.json"]
-        out.print(f"wrote {', '.join(str(p) for p in written)}", markup=False, highlight=False)
+        written = [*result.figures, result.table, stage.path / f"{name}.md", stage.path / f"{name}.json"]
+        out.print(f"wrote {', '.join(str(stage.final_path(p)) for p in written)}", markup=False, highlight=False,
+                  soft_wrap=True)
 
 
 @contextmanager
@@ -684,36 +640,36 @@ def bench_accuracy(
     import time
 
     from .experiments.accuracy import PLANNING_PER_CELL, markdown, run_benchmark
-    from .io.logs import make_folder, write_json
+    from ._json import write_json
     from .experiments.plan import fit_plan
 
     _check_verbosity(quiet, verbose)
-    make_folder(out_dir)  # before the hour of maps, not after
     command = "swarmtopo " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     start = time.perf_counter()
-    try:
+    # staged before the hour of maps (an unwritable --out fails now); the store is never staged: it resumes
+    with output.staged_folder(out_dir, ("accuracy.json", "accuracy.md", "plan.json"), what="accuracy report",
+                              overwrite=True, note=f"finished maps are saved in {store}; run the same command "
+                                                   "again to run the rest") as stage:
         with _sweep_progress(quiet, verbose, label="accuracy") as tick:
             summary = run_benchmark(store, quick=quick, scheduler=scheduler, workers=workers, progress=tick,
                                     planning_per_cell=0 if quick else PLANNING_PER_CELL)
-    except KeyboardInterrupt:
-        if not quiet:
-            err.print(f"interrupted: finished maps are saved in {store}; run the same command again to run the rest",
-                      markup=False, highlight=False, soft_wrap=True)
-        raise typer.Exit(130) from None
-    summary["wall_seconds"] = time.perf_counter() - start
-    text = markdown(summary, command)
-    written = [write_json({k: v for k, v in summary.items()}, out_dir / "accuracy.json")]
-    (out_dir / "accuracy.md").write_text(text, encoding="utf-8")
-    written.append(out_dir / "accuracy.md")
-    try:
-        # ln N and ln N ln T are only told apart from ln T by the planning grid (the suite's budgets raise N and T together)
-        written.append(write_json(fit_plan(summary["records"] + summary["planning"], source=command,
-                                           swarm_terms=2 if summary["planning"] else 0).to_json(), out_dir / "plan.json"))
-    except SwarmtopoError as exc:
-        _warn(f"no plan.json: {exc}", quiet)
+        summary["wall_seconds"] = time.perf_counter() - start
+        text = markdown(summary, command)
+        written = [write_json({k: v for k, v in summary.items()}, stage.path / "accuracy.json")]
+        (stage.path / "accuracy.md").write_text(text, encoding="utf-8")
+        written.append(stage.path / "accuracy.md")
+        try:
+            # ln N and ln N ln T are only told apart from ln T by the planning grid (the suite's budgets
+            # raise N and T together)
+            written.append(write_json(fit_plan(summary["records"] + summary["planning"], source=command,
+                                               swarm_terms=2 if summary["planning"] else 0).to_json(),
+                                      stage.path / "plan.json"))
+        except SwarmtopoError as exc:
+            _warn(f"no plan.json: {exc}", quiet)
     if not quiet:
         out.print(text, markup=False, highlight=False, soft_wrap=True)
-        out.print(f"wrote {', '.join(str(p) for p in written)}", markup=False, highlight=False, soft_wrap=True)
+        out.print(f"wrote {', '.join(str(stage.final_path(p)) for p in written)}", markup=False, highlight=False,
+                  soft_wrap=True)
 
 
 def _plan_input_option(value: str) -> str:
@@ -748,9 +704,10 @@ def plan(
     Give --agents and --duration for the expected accuracy; or one of them and --target
     for the other; --holes if you know how many holes to expect; --input contact-trace
     if the swarm will record encounters only.  Answers come from the accuracy benchmark
-    (docs/accuracy.md).
+    ('swarmtopo bench accuracy'; see the project's documentation, docs/accuracy.md in the
+    source repository).
     """
-    from .pipeline.map import MIN_REGION_AGENTS
+    from .pipeline.regions import MIN_REGION_AGENTS
     from .experiments.plan import load_plan
 
     if agents is not None and agents < MIN_REGION_AGENTS:
@@ -795,17 +752,17 @@ def _plan_answer(what: str, value: float, condition: str) -> str:
     return f"needed: {math.ceil(value)} {what} {condition}"
 
 
-def _run_map(log, config, log_dir: Path, out_dir: Path, quiet: bool, verbose: bool = False, classifier=None,
+def _run_map(log, config, log_dir: Path, out_dir: Path, quiet: bool, verbose: bool = False, reader=None,
              ground_truth=None):
     """Map, write map.json and figures; ground truth beside the log only colours pictures,
     and a broken ground-truth file costs a warning, never the map.  ``ground_truth``
     (arena, truth, trajectories): the caller's, instead of reading them beside the log."""
-    from .pipeline.map import STAGES, map_encounters
+    from .pipeline import STAGES, map_encounters
     from .viz.report import write_map_outputs
 
     with _progress("mapping", quiet) as tick:
         try:
-            tmap = map_encounters(log, config, classifier=classifier,
+            tmap = map_encounters(log, config, reader=reader,
                                   progress=lambda stage: tick(STAGES.index(stage) / len(STAGES)))
         except SwarmtopoError as exc:
             if getattr(exc, "file", None):  # already names its file
@@ -844,7 +801,8 @@ def _map_details(tmap) -> None:
 def _ground_truth(log, log_dir: Path, quiet: bool):
     """(arena, truth, trajectories) beside the log, each None when absent or broken
     (a broken file costs a warning: ground truth only draws pictures)."""
-    from .io.logs import read_arena, read_trajectories, read_truth
+    from .io.arenas import read_arena
+    from .io.logs import read_trajectories, read_truth
 
     arena = truth = trajectories = None
     try:
@@ -879,9 +837,13 @@ def _warn(message: str, quiet: bool) -> None:
 
 
 def _print_verdict(tmap, truth) -> None:
+    from .viz.summary import advice
+
+    from .viz.text import format_confidence
+
     def confidence(n):
         p = tmap.confidence.get(n)
-        return "" if p is None else f" ({100 * p:.0f}% confidence)"
+        return "" if p is None else f" ({format_confidence(p)} confidence)"
 
     est = ", ".join(f"beta_{n} = {b}{confidence(n)}" if b is not None else
                     f"beta_{n} not estimated (the classifier has no threshold for it)"
@@ -891,7 +853,7 @@ def _print_verdict(tmap, truth) -> None:
         out.print(f"true:      beta_0 = {truth[0]}, beta_1 = {truth[1]}")
     for warning in tmap.warnings:
         out.print(f"warning: {warning}", markup=False)
-    for line in tmap.advice():
+    for line in advice(tmap):
         out.print(f"advice: {line}", markup=False, highlight=False, soft_wrap=True)
     for small in tmap.too_little_data:
         out.print(f"note: {small['events']} encounter(s) of {small['agents']} agent(s) never linked to the "
@@ -902,6 +864,9 @@ def main() -> None:
     """Entry point: one-line errors; exit 1 for bad input, 2 for bad usage."""
     try:
         code = app(standalone_mode=False)
+    except _Interrupt as exc:
+        err.print(str(exc), markup=False, highlight=False, soft_wrap=True)
+        sys.exit(130)
     except typer.Abort:
         err.print("aborted", markup=False)
         sys.exit(130)

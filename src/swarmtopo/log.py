@@ -26,6 +26,8 @@ import pyarrow.compute as pc
 
 from .errors import InputError
 
+LOG_FORMAT = "swarmtopo-log/1"
+"""The ``format`` key of a log folder's ``meta.json`` (see :mod:`swarmtopo.io.logs`)."""
 STATES: tuple[str, ...] = ("RW", "WF", "S")
 """Status codes: index in this tuple.  RW random walk, WF wall following, S stopped."""
 RW, WF, S = 0, 1, 2

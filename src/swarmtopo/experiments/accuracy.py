@@ -38,8 +38,9 @@ from ..arena import HOLE_SHAPES, OUTER_SHAPES
 from ..topology.cycles import wilson_interval
 from ..errors import SwarmtopoError
 from ..topology.persistence import Diagram
-from ..readers.ratio import map_confidence, region_reader, vote
-from ..pipeline.map import MapConfig
+from ..readers.paper import published_paper_classifier
+from ..readers.registry import load_classifier
+from ..pipeline import MapConfig
 from .grid import Job, canonical_json, case_streams
 from .sweep import build_arena
 
@@ -66,11 +67,11 @@ PIPELINES: dict[str, dict[str, Any]] = {
                 "window_encounters": MapConfig.window_encounters, "window_scales": list(MapConfig.window_scales),
                 "window_step": "auto", "landmark_bands": [1.0, 0.5], "classifier": "default"},
     "paper": {"metric": "hybrid", "hop_cost": 0.0, "diffusion_time": "none", "wall_follow_weight": "none",
-              "window_length": "none", "classifier": "paper-form"},
+              "window_length": "none", "classifier": "paper"},
 }
 """The pipelines the benchmark compares: swarmtopo's default, and the best
 configuration of the paper's own methods (its metric and subsampler, whole log, its
-classifier form trained our way: the ``paper-form`` preset)."""
+classifier form trained our way: the ``paper`` preset)."""
 
 
 @dataclass(frozen=True)
@@ -282,8 +283,7 @@ def outcomes(rows, classifier, cells=CELLS) -> list[dict[str, Any]]:
     confidences, and whether (beta_0, beta_1) is exactly right.
 
     beta_1 and its confidence are read from the row's stored per-window diagrams by
-    ``classifier`` (each region's windows voted as in the pipeline, with its stored A_k
-    if the classifier gates by agreement), so the table is
+    ``classifier`` (each region's windows read as in the pipeline), so the table is
     the given classifier's verdict on the stored maps: the shipped one's, whatever
     classifier ran the job.  beta_0 and its confidence are the job's (graph components,
     :mod:`swarmtopo.readers.beta0`).  A failed job
@@ -295,13 +295,9 @@ def outcomes(rows, classifier, cells=CELLS) -> list[dict[str, Any]]:
         est0, est1, conf0, conf1 = row["est_betti0"], None, None, None
         if row["error"] is None:
             regions = [[Diagram.from_json(w["diagram"]) for w in r["windows"]] for r in row["diagrams"]]
-            readers = [region_reader(classifier, windows, r.get("agreement"))
-                       for windows, r in zip(regions, row["diagrams"])]
-            votes = [vote(reader, windows) for reader, windows in zip(readers, regions)]
-            est1 = sum(voted[0].get(1, 0) for voted in votes)
-            confs = [reader.region_confidence(windows, voted).get(1)
-                     for reader, windows, voted in zip(readers, regions, votes)]
-            conf1 = map_confidence(classifier, confs, 1)
+            readings = [classifier.read(windows) for windows in regions]
+            est1 = sum(reading.betti.get(1, 0) for reading in readings)
+            conf1 = classifier.map_confidence([reading.confidence.get(1) for reading in readings], 1)
             conf0 = row["confidence_betti0"]
         right = row["error"] is None and est0 == row["true_betti0"] and est1 == row["true_betti1"]
         records.append({
@@ -425,7 +421,6 @@ def run_benchmark(store, *, quick: bool = False, scheduler: str | None = None, w
     Each pipeline's maps are read by its shipped classifier (:func:`outcomes`);
     ``paper-theta`` is the paper pipeline's maps read by the paper's published Theta*.
     """
-    from ..readers.paper import load_classifier
     from .store import job_rows_each
     from .sweep import run_sweep
 
@@ -437,7 +432,7 @@ def run_benchmark(store, *, quick: bool = False, scheduler: str | None = None, w
     by_pipeline = {name: [r for r in rows if _pipeline_of(r["config"]) == name] for name in PIPELINES}
     classifiers = {name: load_classifier(PIPELINES[name]["classifier"]) for name in PIPELINES}
     results = {name: outcomes(subset, classifiers[name]) for name, subset in by_pipeline.items()}
-    results["paper-theta"] = outcomes(by_pipeline["paper"], load_classifier("paper"))
+    results["paper-theta"] = outcomes(by_pipeline["paper"], published_paper_classifier())
     planning_records = outcomes(planning_rows, classifiers["default"], cells=planning_cells)
     return {
         "suite": SUITE, "cases_per_cell": per_cell, "maps": len(rows),

@@ -21,7 +21,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .._validate import positive_int
-from ..readers.paper import detection_scores, paper_classifier
+from ..readers.paper import detection_scores, published_paper_classifier
 from ..topology.persistence import Diagram
 from .grid import expand_grid
 from .store import read_jobs
@@ -34,7 +34,7 @@ RUNS = 100
 """Environments per set (paper: 100)."""
 CLUST_SWARM = {"agents": 200, "duration": 30.0}
 CLUST_MAP = {"metric": "contracted", "hop_cost": 0.0, "diffusion_time": "none", "wall_follow_weight": "none",
-             "window_length": "none", "subsample": "maxmin", "landmarks": 300, "classifier": "paper-form"}
+             "window_length": "none", "subsample": "maxmin", "landmarks": 300, "classifier": "paper"}
 CLUST_ARENA = {"generator": "random", "shapes": "square", "outer": "square"}
 
 
@@ -67,7 +67,7 @@ def reproduce_clust(out: Path, *, runs: int | None = None, progress: Callable[[i
     train = examples_from_rows(rows["train"])
 
     selection = fit_and_select(train, _test_pool(rows), {"name": "clust", "runs": runs})
-    models = {**selection.fits, "paper": paper_classifier()}
+    models = {**selection.fits, "paper": published_paper_classifier()}
 
     test_sets = _test_sets(rows)
     table: list[dict[str, Any]] = []

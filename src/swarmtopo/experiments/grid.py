@@ -84,12 +84,10 @@ from typing import Any, Callable
 import numpy as np
 
 from ..arena import HOLE_SHAPES, OUTER_SHAPES
-from ..readers.paper import PRESETS, load_classifier
+from ..readers.registry import PRESETS, load_classifier
 from ..errors import InputError, SwarmtopoError
-from ..metric.graph import METRICS
-from ..io.logs import read_arena
-from ..metric.landmarks import SUBSAMPLERS
-from ..pipeline.map import MapConfig, seconds_option, wall_follow_option
+from ..io import read_arena
+from ..pipeline.config import OPTIONS, ConfigError, MapConfig, config_from_options
 from ..sim.simulate import check_parameters
 
 GENERATORS: dict[str, tuple[str, ...]] = {
@@ -167,26 +165,14 @@ def _scale_set(value) -> tuple[float, ...]:
     return tuple(sorted(set(checked)))
 
 
-def _or_word(words: str | tuple[str, ...], check: Callable[[Any], float]) -> Callable[[Any], Any]:
-    """A number passing ``check``, or one of the strings ``words`` ("auto", "none")."""
-    words = (words,) if isinstance(words, str) else words
-
-    def either(value):
-        if value in words:
-            return value
+def _option(name: str) -> Callable[[Any], Any]:
+    """A ``[map]`` key checked by the map's own option parser (``pipeline.config.OPTIONS``)."""
+    def check(value):
         try:
-            return check(value)
-        except _Bad as exc:
-            raise _Bad(f"{exc} or " + " or ".join(f'"{w}"' for w in words)) from None
-    return either
-
-
-def _landmarks(value):
-    if value == "auto":
-        return value
-    if isinstance(value, bool) or not isinstance(value, int) or value < 3:
-        raise _Bad('expected an integer >= 3 or "auto"')
-    return int(value)
+            return OPTIONS[name].canonical(value)
+        except ConfigError as exc:
+            raise _Bad(f"expected {exc.expected}") from None
+    return check
 
 
 @dataclass(frozen=True)
@@ -215,20 +201,15 @@ PARAMS: tuple[Param, ...] = (
     Param("swarm", "duration", 20.0, _number(0.0, strict=True), "DOUBLE"),
     Param("swarm", "static_fraction", 0.0, _number(0.0, strict=False, hi=1.0), "DOUBLE"),
     Param("swarm", "static_time", 0.0, _number(0.0, strict=False), "DOUBLE"),
-    Param("map", "metric", "hybrid", _choice(METRICS), "TEXT"),
-    Param("map", "hop_cost", "auto", _or_word("auto", _number(0.0, strict=False)), "DOUBLE"),
-    Param("map", "diffusion_time", "auto", _or_word(("auto", "none"), _number(0.0, strict=True)), "DOUBLE"),
-    Param("map", "wall_follow_weight", MapConfig().wall_follow_weight, _or_word("none", _number(0.0, strict=False)),
-          "DOUBLE"),
-    Param("map", "window_length", "auto", _or_word(("auto", "none"), _number(0.0, strict=True)), "DOUBLE"),
-    Param("map", "window_encounters", MapConfig().window_encounters, _number(0.0, strict=True), "DOUBLE"),
+    *(Param("map", name, default, _option(name), sql) for name, default, sql in (
+        ("metric", "hybrid", "TEXT"), ("hop_cost", "auto", "DOUBLE"), ("diffusion_time", "auto", "DOUBLE"),
+        ("wall_follow_weight", MapConfig().wall_follow_weight, "DOUBLE"), ("window_length", "auto", "DOUBLE"),
+        ("window_encounters", MapConfig().window_encounters, "DOUBLE"))),
     Param("map", "window_scales", tuple(sorted(MapConfig().window_scales)), _scale_set, "DOUBLE[]",
           set_valued=True),
-    Param("map", "window_step", "auto", _or_word("auto", _number(0.0, strict=True)), "DOUBLE"),
-    Param("map", "subsample", "maxmin", _choice(tuple(SUBSAMPLERS)), "TEXT"),
-    Param("map", "landmarks", "auto", _landmarks, "INTEGER"),
-    Param("map", "max_landmarks", MapConfig().max_landmarks, _integer(3), "INTEGER"),
-    Param("map", "maxdim", 1, _integer(1, 2), "INTEGER"),
+    *(Param("map", name, default, _option(name), sql) for name, default, sql in (
+        ("window_step", "auto", "DOUBLE"), ("subsample", "maxmin", "TEXT"), ("landmarks", "auto", "INTEGER"),
+        ("max_landmarks", MapConfig().max_landmarks, "INTEGER"), ("maxdim", 1, "INTEGER"))),
     Param("map", "classifier", "default", _text, "TEXT"),
 )
 """Every grid key, in expansion order (the last key varies fastest)."""
@@ -337,7 +318,8 @@ def read_sweep(path) -> Sweep:
     ------
     InputError
         On a syntax error, an unknown table or key, a wrong type or an out-of-range
-        value: one line naming the file, the key and the value.
+        value: one line naming the file, the key and the value; or when no table of
+        the grid has a key (an empty file would run one job of the defaults).
     """
     path = Path(path)
     try:
@@ -350,7 +332,12 @@ def read_sweep(path) -> Sweep:
         document = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"invalid TOML: {exc}", file=str(path)) from None
-    return expand_grid(document, source=str(path), base_dir=path.parent, default_name=path.stem)
+    sweep = expand_grid(document, source=str(path), base_dir=path.parent, default_name=path.stem)
+    if not any(document.get(table) for table in GRID_TABLES):  # a typo'd table was refused above
+        tables = [f"[{table}]" for table in GRID_TABLES]
+        raise InputError(f"no key in {', '.join(tables[:-1])} or {tables[-1]}: nothing to sweep (give at least one "
+                         "value, e.g. [swarm] agents = 200)", file=str(path))
+    return sweep
 
 
 def expand_grid(document: dict, *, source: str = "<grid>", base_dir=None,
@@ -443,31 +430,13 @@ def job_simulation_args(swarm: dict[str, Any]) -> dict[str, Any]:
 
 
 def job_map_config(mapping: dict[str, Any], seed: int | None = None) -> MapConfig:
-    """The ``MapConfig`` of a job's canonical ``[map]`` table ("auto" -> None, from the
-    data; "none" -> inf, except a "none" wall-following weight -> None), as sweeps map:
-    no picture, no loops; every other option is ``swarmtopo map``'s default, the window
-    cap ``max_windows`` included (not a grid key: no map of the accuracy suite reaches it), and
-    ``agreement`` ("auto" unless the table says, as the gate's fitting jobs do) and
-    ``landmark_bands`` (absent or "auto": the bands the job's classifier was fitted with)."""
-    return MapConfig(
-        metric=mapping["metric"], subsample=mapping["subsample"],
-        hop_cost=seconds_option(mapping["hop_cost"]),
-        diffusion_time=seconds_option(mapping["diffusion_time"]),
-        wall_follow_weight=wall_follow_option(mapping["wall_follow_weight"]),
-        window_length=seconds_option(mapping["window_length"]),
-        window_encounters=mapping.get("window_encounters", MapConfig.window_encounters),
-        window_scales=tuple(mapping.get("window_scales", MapConfig.window_scales)),
-        window_step=seconds_option(mapping.get("window_step")),
-        landmark_bands=landmark_bands_option(mapping.get("landmark_bands", "auto")),
-        landmarks=None if mapping["landmarks"] == "auto" else mapping["landmarks"],
-        max_landmarks=mapping.get("max_landmarks", MapConfig.max_landmarks),
-        maxdim=mapping["maxdim"], seed=seed, embed_dim=0, cycles=False,
-        agreement=mapping.get("agreement", MapConfig.agreement))
-
-
-def landmark_bands_option(value) -> tuple[float, ...] | None:
-    """A ``[map]`` table's ``landmark_bands``: "auto" -> None (the classifier's own), else the bands."""
-    return None if value == "auto" else tuple(value)
+    """The ``MapConfig`` of a job's canonical ``[map]`` table, through the map's own option
+    parser (``pipeline.config.config_from_options``), as sweeps map: no picture, no loops;
+    every other option is ``swarmtopo map``'s default, the window cap ``max_windows``
+    included (not a grid key: no map of the accuracy suite reaches it), and
+    ``landmark_bands`` (absent or "auto": the bands the job's reader was fitted with)."""
+    options = {name: mapping[name] for name in OPTIONS if name in mapping}
+    return config_from_options(options, seed=seed, embed_dim=0, cycles=False)
 
 
 # -- internals ----------------------------------------------------------------------------

@@ -185,7 +185,7 @@ def load_plan(path: str | Path | None = None, reading: str = "log") -> PlanModel
         name = SHIPPED_PLANS[reading]
         text = resources.files("swarmtopo.data").joinpath(name).read_text("utf-8")
         return PlanModel.from_json(json.loads(text), source=f"swarmtopo/data/{name}")
-    from ..io.logs import read_json
+    from .._json import read_json
 
     return PlanModel.from_json(read_json(path), source=str(path))
 

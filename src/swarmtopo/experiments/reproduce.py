@@ -25,7 +25,7 @@ constants; docs/reproduction.md says why): the 500 mm square with one centred 15
 square hole (:func:`swarmtopo.arena.default_arena`), 200 agents in it (the same density
 of agents per mm^2 of free space elsewhere), the paper's motion parameters, r_d = 30 mm,
 dt = 0.1 s, the paper's pipeline (no per-hop cost, the whole log at once, the paper's
-classifier form trained our way: the ``paper-form`` preset) and the pipeline's
+classifier form trained our way: the ``paper`` preset) and the pipeline's
 defaults for everything else (maxmin, the automatic landmark count capped at 1000,
 landmark and MDS seed 0).
 
@@ -48,19 +48,21 @@ from scipy.stats import spearmanr
 
 from .._validate import positive_int
 from ..arena import Arena, annulus_arena, default_arena
-from ..readers.paper import load_classifier
+from ..readers.registry import load_classifier
 from ..topology.cycles import event_positions
 from ..topology.embed import mds
 from ..errors import InputError, SwarmtopoError
 from ..metric.graph import build_graph
-from ..io.logs import jsonable, write_json
+from .._json import jsonable, write_json
 from ..metric.landmarks import knn_maxmin, maxmin, probabilistic_maxmin
 from ..topology.persistence import Diagram, rips_persistence, snr
-from ..pipeline.map import WHOLE_LOG, MapConfig, TopologicalMap, map_encounters, software_versions
+from ..pipeline import MapConfig, TopologicalMap, map_encounters
+from ..pipeline.config import WHOLE_LOG
+from ..pipeline.result import software_versions
 from ..sim import simulate
 from .clust import reproduce_clust
 
-PAPER_CLASSIFIER = "paper-form"
+PAPER_CLASSIFIER = "paper"
 """The reproductions read Betti numbers with the paper's classifier form, trained our way."""
 
 Progress = Callable[[int, int, int], None]
@@ -493,6 +495,12 @@ REPRODUCTIONS: dict[str, Callable[..., Reproduction]] = {
 (clust's options: ``workers``, ``scheduler``, ``store``; see :mod:`.clust`)."""
 
 
+def output_names(name: str) -> tuple[str, ...]:
+    """Every file experiment ``name`` may write into its folder: NAME.csv, .md, .json and
+    its figures NAME.png and NAME-runs.png (clust's store, clust.duckdb, is not an output)."""
+    return tuple(f"{name}{suffix}" for suffix in (".csv", ".md", ".json", ".png", "-runs.png"))
+
+
 # -- helpers ----------------------------------------------------------------------------
 class _Ticker:
     """Counts finished units and calls ``progress(done, total, failed)``."""
@@ -532,7 +540,7 @@ def _config(metric: str, *, picture: bool, window=None) -> MapConfig:
 def _map(log, config: MapConfig) -> tuple[TopologicalMap | None, str]:
     """The map, or None and the reason when there is too little data to map."""
     try:
-        return map_encounters(log, config, classifier=load_classifier(PAPER_CLASSIFIER)), ""
+        return map_encounters(log, config, reader=load_classifier(PAPER_CLASSIFIER)), ""
     except SwarmtopoError as exc:
         return None, str(exc)
 

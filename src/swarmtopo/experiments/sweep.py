@@ -32,12 +32,15 @@ from functools import lru_cache
 from typing import Any, Callable, Iterable
 
 from ..arena import Arena, annulus_arena, default_arena, random_arena, square_arena, two_rooms_arena
-from ..readers.paper import PRESETS, BettiClassifier, load_classifier
+from ..readers.base import BettiReader
+from ..readers.registry import PRESETS, load_classifier
 from ..errors import SwarmtopoError
-from ..io.logs import GROUND_TRUTH_META_KEYS, read_arena, read_log, write_log
+from ..io import GROUND_TRUTH_META_KEYS, read_arena, read_log, write_log
 from ..log import EncounterLog
 from ..topology.persistence import snr
-from ..pipeline.map import agreement_json, map_encounters, software_versions
+from ..pipeline import map_encounters
+from ..pipeline.result import software_versions
+from ..viz.summary import window_json
 from ..sim import simulate
 from .grid import Job, flat_columns, job_map_config, job_simulation_args
 from .store import JOB_COLUMNS, ResultStore
@@ -125,7 +128,7 @@ def map_input(mapping: dict[str, Any]) -> str:
 
 def job_classifier(mapping: dict[str, Any]) -> str:
     """The classifier a job's map is read with: its ``[map]`` table's, "default" being
-    ``map``'s own for what the job reads (:func:`~swarmtopo.pipeline.map.shipped_classifier_for`:
+    ``map``'s own for what the job reads (:func:`~swarmtopo.readers.registry.shipped_reader_for`:
     ``trace`` for a contact trace; a simulated log always has status rows)."""
     name = mapping["classifier"]
     return "trace" if name == "default" and map_input(mapping) == "contact-trace" else name
@@ -165,7 +168,7 @@ def run_job(job: Job) -> dict[str, Any]:
         log = stripped_log(sim.log)
         tmap = map_encounters(contact_trace(log) if map_input(mapping) == "contact-trace" else log,
                               job_map_config(mapping, seeds["map"]),
-                              classifier=cached_classifier(job_classifier(mapping), job.file("map.classifier")))
+                              reader=cached_classifier(job_classifier(mapping), job.file("map.classifier")))
     except SwarmtopoError as exc:
         row["error"] = " ".join(str(exc).split())
     else:
@@ -176,8 +179,8 @@ def run_job(job: Job) -> dict[str, Any]:
             snr_h1=ratio.ratio, noise_power_h1=ratio.noise_power,
             lengths_h1=[float(x) for x in tmap.diagram.lengths(1)],
             diagrams=[{"events": r.n_events, "agents": r.n_agents, "landmarks": len(r.landmarks.nodes),
-                       "diagram": r.diagram.to_json(), "window": r.window, "agreement": agreement_json(r.agreement),
-                       "windows": [{**w.to_json(), "diagram": w.diagram.to_json()} for w in r.windows]}
+                       "diagram": r.diagram.to_json(), "window": r.window,
+                       "windows": [{**window_json(w), "diagram": w.diagram.to_json()} for w in r.windows]}
                       for r in tmap.regions],
             n_regions=len(tmap.regions),
             **{column: tmap.timings[stage] for stage, column in _STAGE_COLUMNS.items()},
@@ -375,7 +378,7 @@ def dask_setup(worker) -> None:
 
 
 @lru_cache(maxsize=8)
-def cached_classifier(name: str, path: str | None = None) -> BettiClassifier:
+def cached_classifier(name: str, path: str | None = None) -> BettiReader:
     """The classifier of a job: the preset ``name``, else the file at ``path``; loaded
     once per process (per worker, or per store read by the tuning code)."""
     return load_classifier(name if name in PRESETS else path)

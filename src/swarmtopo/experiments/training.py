@@ -30,9 +30,9 @@ DEFAULT_TRAINING: dict[str, Any] = {
               "outer": ["square", "rectangle", "polygon"], "scale": [0.75, 1.0, 1.25]},
     "swarm": {"agents": [200, 400], "duration": [20.0, 60.0]},
     "map": {"hop_cost": 0.0, "diffusion_time": "none", "wall_follow_weight": "none", "window_length": "none",
-            "classifier": "paper-form"},
+            "classifier": "paper"},
 }
-"""The paper-form classifier's training sweep: random arenas with 0-3 holes of every
+"""The ``paper`` classifier's training sweep: random arenas with 0-3 holes of every
 shape family, three outer walls, scales 0.75-1.25, 200 or 400 agents for 20 or 60 s,
 mapped with the paper's pipeline (no per-hop cost, whole log), 2 replicates."""
 

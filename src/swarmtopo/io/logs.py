@@ -1,4 +1,4 @@
-"""Files in and out: log folders, arenas (GeoJSON) and JSON.
+"""Log folders in and out: events, status, meta.json and the simulator's ground truth.
 
 The log folder is the contract between whoever records a deployment (the simulator,
 a real base station, someone's script) and ``swarmtopo map``.  A folder ``DIR`` holds
@@ -21,38 +21,36 @@ file                   columns / keys                       status
 ``trajectories.<fmt>`` ``t, agent, x, y[, state]``          optional, ground truth
 =====================  ===================================  ==========================
 
-``fmt`` is ``csv`` or ``parquet`` (one of them per file name); text is UTF-8.  Times
-are in seconds, positions in millimetres.  The ``meta.json`` keys ``format``
-(:data:`LOG_FORMAT`, this layout) and ``version`` (of the swarmtopo that made the log)
-are optional; simulated logs carry both, and :func:`read_log` refuses a folder of
-another ``format``.  Agent IDs are integers or text: in a CSV file an ID column is
-integer only if every ID in the folder is written as an integer (``7``, or ``7.0`` as a
-float column is often written: the same agent; not ``007`` or ``-0``) and ``meta.json``
-does not declare text ``agent_ids``; otherwise all IDs are text, so ``"007"`` stays
-``"007"``.  Blanks round a CSV ID are dropped unless ``meta.json``'s ``agent_ids``
-lists the ID with them (so padded text IDs that :func:`write_log` wrote read back
-exactly); two text IDs that differ only in such blanks are refused, not merged.  CSV
-blank lines count as data rows and are skipped.  Extra columns are ignored by
-:func:`read_log` (a name they repeat, such as the empty names of trailing empty
-columns, too) and kept by :func:`read_truth` / :func:`read_trajectories`.
+``fmt`` is ``csv``, ``csv.gz`` (gzip-compressed CSV, read only) or ``parquet``, one of
+them per table (two versions of one table are refused); text is UTF-8, and a ``.csv``
+file holding gzip data is refused (name it ``.csv.gz``).  Times are in seconds,
+positions in millimetres.  The ``meta.json`` keys ``format`` (:data:`LOG_FORMAT`, this
+layout) and ``version`` (of the swarmtopo that made the log) are optional; simulated
+logs carry both, and :func:`read_log` refuses a folder of another ``format``.
 
-CSV and Parquet go through pyarrow (multi-threaded C++ readers) and ID columns are
-dictionary-encoded, never turned into Python objects row by row: 10^6 events read in
-about a second from CSV and half a second from Parquet.  Every error a file can cause
-is an :class:`~.errors.InputError` naming the file, the 1-based data row, the column
-and the value; so is a file system refusing a read or a write.
+Agent IDs are read by :func:`.tables.id_columns`: integers or text, one kind for the
+whole folder (``meta.json``'s text ``agent_ids`` make them text), blanks round a CSV ID
+dropped unless ``agent_ids`` lists the ID with them (so padded text IDs that
+:func:`write_log` wrote read back exactly).  Without ``agent_ids`` / ``agent_count``,
+every agent of the status file must appear in the events: an agent that met nobody is
+declared, never guessed.  CSV blank lines count as data rows and are skipped.  Extra
+columns are ignored by :func:`read_log` (a name they repeat, such as the empty names
+of trailing empty columns, too) and kept by :func:`read_truth` /
+:func:`read_trajectories`.
+
+Tables are parsed by :mod:`.tables` (pyarrow's multi-threaded readers, ID columns
+dictionary-encoded): 10^6 events read in about a second from CSV and half a second
+from Parquet.  Every error a file can cause is an :class:`~.errors.InputError` naming
+the file, the 1-based data row, the column and the value; so is a file system refusing
+a read or a write.
 """
 
 from __future__ import annotations
 
-import itertools
 import json
 import math
-import os
-import re
 import shutil
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pyarrow as pa
@@ -60,33 +58,30 @@ import pyarrow.compute as pc
 import pyarrow.csv as pcsv
 import pyarrow.parquet as pq
 
+from .._json import atomic_write as _atomic_write
+from .._json import os_reason as _os_reason
+from .._json import read_json, write_json
 from ..arena import Arena
 from ..errors import InputError, SwarmtopoError
-from ..log import EncounterLog, float_ids, parse_states, refuse_nul_ids, state_labels
+from ..log import LOG_FORMAT, EncounterLog, float_ids, parse_states, refuse_nul_ids, state_labels
+from .arenas import write_arena
+from .tables import (IdColumn, blank_rows, csv_header, existing_file, find_columns, id_columns, is_gzip,
+                     number_column, parquet_file, read_csv, read_error, read_parquet, trim)
 
 FORMATS: tuple[str, ...] = ("csv", "parquet")
-LOG_FORMAT = "swarmtopo-log/1"
-"""The ``format`` key of ``meta.json`` for the layout this module reads and writes."""
+"""Formats :func:`write_log` writes."""
+TABLE_SUFFIXES = (".csv", ".csv.gz", ".parquet")
+"""File name endings of a table that :func:`read_log` reads."""
 EVENT_COLUMNS = ("t", "a", "b")
 STATUS_COLUMNS = ("t", "agent", "state")
 TRUTH_COLUMNS = ("t", "a", "b", "xa", "ya", "xb", "yb")
 TRAJECTORY_COLUMNS = ("t", "agent", "x", "y")
-GROUND_TRUTH_FILES = ("arena.geojson", *(f"{stem}.{fmt}" for stem in ("truth", "trajectories") for fmt in FORMATS))
+GROUND_TRUTH_FILES = ("arena.geojson",
+                      *(f"{stem}{suffix}" for stem in ("truth", "trajectories") for suffix in TABLE_SUFFIXES))
 """Files that only a simulator can write; ``swarmtopo map`` never reads them."""
 
 _TABLE_STEMS = ("events", "status", "truth", "trajectories")
 _ID_COLUMNS = ("a", "b", "agent")
-_OTHER_ENCODINGS = ((b"\xff\xfe\x00\x00", "UTF-32"), (b"\x00\x00\xfe\xff", "UTF-32"),
-                    (b"\xff\xfe", "UTF-16"), (b"\xfe\xff", "UTF-16"))
-_INTEGER_TEXT = r"^(0|-?[1-9][0-9]*)(\.0+)?$"
-"""An ID written as an integer: plain (not 017, not -0: those stay text), or with a zero
-fraction, as a float column is often written (12.0 is agent 12, as in a Parquet float column)."""
-GZIP_MAGIC = b"\x1f\x8b"
-SNIFF_BYTES = 1 << 16  # the first block of a CSV file checked for binary data
-MAX_TIME_RESOLUTION = 1e-3
-"""Coarsest spacing (s) a float16 / float32 time column may have at its largest value:
-beyond it the file's times were already rounded when written (float32 epoch seconds are
-128 s apart), so they are refused rather than read as fewer, shifted times."""
 
 
 # -- log folders -------------------------------------------------------------------------
@@ -174,7 +169,7 @@ def log_files(directory) -> list[Path]:
     """The contract files (``events.*``, ``status.*``, ``truth.*``, ``trajectories.*``,
     ``meta.json``, ``arena.geojson``) present in ``directory``: what :func:`write_log`
     writes there or deletes as outdated."""
-    names = [f"{stem}.{f}" for stem in _TABLE_STEMS for f in FORMATS] + ["meta.json", "arena.geojson"]
+    names = [f"{stem}{suffix}" for stem in _TABLE_STEMS for suffix in TABLE_SUFFIXES] + ["meta.json", "arena.geojson"]
     return [Path(directory) / name for name in names if (Path(directory) / name).is_file()]
 
 
@@ -191,10 +186,11 @@ def read_log(directory) -> EncounterLog:
         Naming the file, the 1-based data row, the column and the value: missing
         file or column, unparsable CSV, non-numeric / NaN / negative / missing times,
         missing IDs, float IDs that are not whole numbers within int64, CSV text IDs
-        that differ only in surrounding blanks, a == b, unknown states, IDs outside ``agent_ids`` /
-        ``agent_count``, duplicate events, two status rows for one agent at one time,
+        that differ only in surrounding blanks, a == b, unknown states, IDs outside
+        ``agent_ids`` / ``agent_count``, without them a status agent that never appears
+        in the events, duplicate events, two status rows for one agent at one time,
         text that is not UTF-8, malformed ``meta.json`` or another ``format``; or when
-        both ``events.csv`` and ``events.parquet`` exist.
+        two versions of one table exist (``events.csv`` and ``events.parquet``).
     """
     directory = _log_dir(directory)
     meta_path = directory / "meta.json"
@@ -204,14 +200,16 @@ def read_log(directory) -> EncounterLog:
     events, event_rows = _read_table(events_path, EVENT_COLUMNS)
     status, status_rows = _read_table(status_path, STATUS_COLUMNS) if status_path else (None, None)
 
-    id_cols = [(events[c], events_path, c, event_rows) for c in ("a", "b")]
+    id_cols = [IdColumn(events[c], events_path, c, event_rows, _is_csv(events_path)) for c in ("a", "b")]
     if status is not None:
-        id_cols.append((status["agent"], status_path, "agent", status_rows))
-    ids = _id_arrays(id_cols, declared=meta.get("agent_ids"))
-    t = _number_column(events["t"], events_path, "t", "time", event_rows)
-    status_cols = None
+        id_cols.append(IdColumn(status["agent"], status_path, "agent", status_rows, _is_csv(status_path)))
+    ids = id_columns(id_cols, declared=meta.get("agent_ids"))
+    t = number_column(events["t"], events_path, "t", "time", event_rows)
+    status_cols = unmet = None
     if status is not None:
-        status_cols = (_number_column(status["t"], status_path, "t", "time", status_rows), ids[2], status["state"])
+        status_cols = (number_column(status["t"], status_path, "t", "time", status_rows), ids[2], status["state"])
+        if meta.get("agent_ids") is None and meta.get("agent_count") is None:
+            unmet = _unmet(*ids)
     static = meta.pop("static", None)
     static_cols = None
     if static is not None:
@@ -225,8 +223,12 @@ def read_log(directory) -> EncounterLog:
     except InputError as exc:
         tables = {str(events_path): (events, event_rows), str(status_path): (status, status_rows)}
         raise _as_written(exc, tables) from None
-    if meta.get("agent_ids") is None and meta.get("agent_count") is None:
-        _refuse_unmatched_status(log, status_path, events_path)
+    if unmet is not None and unmet.any():
+        i = int(np.argmax(unmet))
+        hint = ("none of this file's agents does: are the IDs written the same way in both files?" if unmet.all()
+                else "an agent that met nobody is declared in meta.json's agent_ids or agent_count")
+        raise InputError(f"agent never appears in {events_path.name} ({hint})", file=str(status_path),
+                         row=int(status_rows[i]), column="agent", value=status["agent"][i].as_py())
     if "duration" in meta and meta["duration"] < log.last_time:
         raise InputError(f"key 'duration' is {meta['duration']:g} s but the log runs to t = {log.last_time:g} s",
                          file=str(meta_path), column="duration", value=meta["duration"])
@@ -244,18 +246,11 @@ def _as_written(exc: InputError, tables: dict) -> InputError:
     return InputError(exc.reason, file=exc.file, row=exc.row, column=exc.column, value=value)
 
 
-def _refuse_unmatched_status(log: EncounterLog, status_path, events_path) -> None:
-    """Without a declared agent set, a status file none of whose agents is in any event
-    (while there are events) spells its IDs differently from the events: refused."""
-    if not (log.n_events and len(log.status_agent)):
-        return
-    met = np.zeros(log.n_agents, bool)
-    met[log.a] = met[log.b] = True
-    if not met[log.status_agent].any():
-        example = log.ids_of(log.status_agent[:1])[0]
-        raise InputError(f"none of its agents appears in {events_path.name} (are the IDs written the same way in "
-                         f"both files?)", file=str(status_path), column="agent",
-                         value=int(example) if isinstance(example, np.integer) else example)
+def _unmet(a, b, agent) -> np.ndarray:
+    """Mask of the status rows whose agent is in no event (IDs as :func:`.tables.id_columns` gives them)."""
+    if isinstance(agent, np.ndarray):
+        return ~np.isin(agent, np.concatenate([a, b]))
+    return ~pc.is_in(agent, value_set=pa.concat_arrays([a, b])).to_numpy(zero_copy_only=False)
 
 
 def read_truth(directory) -> dict[str, np.ndarray] | None:
@@ -288,7 +283,7 @@ def read_trajectories(directory) -> dict[str, np.ndarray] | None:
     return out
 
 
-def _read_ground_truth(directory, name: str, columns, id_columns, position_columns):
+def _read_ground_truth(directory, name: str, columns, id_names, position_columns):
     """(path, table, arrays) of the ground-truth table ``name.<fmt>``, or None if absent:
     ``t`` and the positions as float64, the ID columns as the log reads IDs."""
     directory = _log_dir(directory)
@@ -297,11 +292,11 @@ def _read_ground_truth(directory, name: str, columns, id_columns, position_colum
         return None
     table, rows = _read_table(path, columns, keep_all=True)
     declared = _read_meta(directory / "meta.json").get("agent_ids")
-    ids = _id_arrays([(table[col], path, col, rows) for col in id_columns], declared=declared)
-    out = {"t": _number_column(table["t"], path, "t", "time", rows)}
-    out.update({col: _id_numpy(values, path, col, rows) for col, values in zip(id_columns, ids)})
+    ids = id_columns([IdColumn(table[col], path, col, rows, _is_csv(path)) for col in id_names], declared=declared)
+    out = {"t": number_column(table["t"], path, "t", "time", rows)}
+    out.update({col: _id_numpy(values, path, col, rows) for col, values in zip(id_names, ids)})
     for col in position_columns:
-        out[col] = _number_column(table[col], path, col, "position", rows)
+        out[col] = number_column(table[col], path, col, "position", rows)
     return path, table, out
 
 
@@ -332,76 +327,6 @@ def strip_ground_truth(src_dir, dst_dir) -> None:
             for key in GROUND_TRUTH_META_KEYS:
                 meta.pop(key, None)
         write_json(meta, dst / "meta.json")
-
-
-# -- arenas and JSON -----------------------------------------------------------------------
-def read_arena(path) -> Arena:
-    """Read an arena from a GeoJSON file (Polygon, MultiPolygon, Feature or FeatureCollection)."""
-    return Arena.from_geojson(read_json(path), source=str(path))
-
-
-def write_arena(arena: Arena, path) -> Path:
-    """Write an arena as a GeoJSON Feature; returns the path."""
-    return write_json(arena.to_geojson(), path)
-
-
-def read_json(path) -> Any:
-    """Parse a JSON file; errors name the file and the line and column of a syntax error."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InputError("file not found", file=str(path)) from None
-    except UnicodeDecodeError as exc:
-        raise InputError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=str(path)) from None
-    except OSError as exc:
-        raise InputError(f"cannot read file ({_os_reason(exc)})", file=str(path)) from None
-    try:
-        return json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise InputError(f"invalid JSON: {exc.msg} (line {exc.lineno}, column {exc.colno})", file=str(path)) from None
-
-
-def write_json(obj, path) -> Path:
-    """Write JSON with sorted keys and 2-space indent (byte-stable); returns the path.
-
-    numpy scalars and arrays are written as plain numbers and lists, paths as text;
-    NaN and infinities are refused (they are not JSON: pass ``jsonable(obj)`` to
-    write them as ``null`` / ``"inf"`` / ``"-inf"``).
-    """
-    path = Path(path)
-    try:
-        text = json.dumps(obj, sort_keys=True, indent=2, allow_nan=False, default=_builtin)
-    except ValueError as exc:
-        raise InputError(f"cannot write JSON: {exc}", file=str(path)) from None
-    _atomic_write(path, lambda tmp: tmp.write_text(text + "\n", encoding="utf-8"))
-    return path
-
-
-def jsonable(obj) -> Any:
-    """``obj`` as plain JSON data: dict (keys made ``str``), list, str, int, float, bool, None.
-
-    Recursively: dicts -> dicts with ``str(key)`` keys, lists / tuples / numpy arrays ->
-    lists, numpy scalars -> int / float / bool, paths -> str, and non-finite floats ->
-    ``"inf"``, ``"-inf"`` or ``None`` (NaN).  Anything else raises TypeError.  Use it
-    for data that may hold infinities (``tau_stop = inf``, open intervals);
-    :func:`write_json` alone refuses them.
-    """
-    if isinstance(obj, dict):
-        return {k if isinstance(k, str) else str(k): jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [jsonable(v) for v in obj]
-    if isinstance(obj, (np.ndarray, np.generic, Path)):
-        return jsonable(_builtin(obj))
-    if obj is None or isinstance(obj, (str, bool)):
-        return obj
-    if isinstance(obj, int):
-        return int(obj)
-    if isinstance(obj, float):
-        if math.isfinite(obj):
-            return float(obj)
-        return None if math.isnan(obj) else ("inf" if obj > 0 else "-inf")
-    raise TypeError(f"object of type {type(obj).__name__} is not JSON serializable")
 
 
 # -- writing helpers -----------------------------------------------------------------------
@@ -476,48 +401,11 @@ def make_folder(directory: Path) -> None:
         raise InputError(f"cannot create the output folder ({reason})", file=str(directory)) from None
 
 
-def _atomic_write(path: Path, write) -> None:
-    """Write through a temporary file in the same folder, then rename over ``path``.
-
-    Raises InputError naming ``path`` if the file system refuses (no such folder, a
-    folder of that name, no permission, disk full).
-    """
-    tmp = path.with_name(f".{path.name}.tmp")
-    try:
-        try:
-            write(tmp)
-            os.replace(tmp, path)
-        finally:
-            tmp.unlink(missing_ok=True)
-    except OSError as exc:
-        raise InputError(f"cannot write file ({_os_reason(exc)})", file=str(path)) from None
-
-
-def _os_reason(exc: OSError) -> str:
-    return exc.strerror or str(exc)
-
-
 def _json_id(value):
     return int(value) if isinstance(value, (int, np.integer)) else str(value)
 
 
-def _builtin(obj):
-    """numpy scalar / array or path -> the Python int, float, bool, list or str (the
-    ``default`` of json.dumps: called only for objects json cannot write itself)."""
-    if isinstance(obj, (np.ndarray, np.generic)):
-        return obj.tolist()
-    if isinstance(obj, Path):
-        return str(obj)
-    raise TypeError(f"object of type {type(obj).__name__} is not JSON serializable")
-
-
 # -- reading helpers -----------------------------------------------------------------------
-def _not_a_folder(path: Path) -> None:
-    """A log file that is a folder is refused, not skipped as absent."""
-    if path.is_dir():
-        raise InputError("is a folder, not a log file", file=str(path))
-
-
 def _log_dir(directory) -> Path:
     directory = Path(directory)
     if not directory.is_dir():
@@ -526,15 +414,22 @@ def _log_dir(directory) -> Path:
     return directory
 
 
+def _is_csv(path: Path) -> bool:
+    return path.name.endswith((".csv", ".csv.gz"))
+
+
 def _find_table(directory: Path, stem: str, *, required: bool = False) -> Path | None:
-    for fmt in FORMATS:
-        _not_a_folder(directory / f"{stem}.{fmt}")
-    found = [directory / f"{stem}.{fmt}" for fmt in FORMATS if (directory / f"{stem}.{fmt}").is_file()]
+    """The one file of table ``stem`` (``events.csv``, ``.csv.gz`` or ``.parquet``), or None."""
+    found = [existing_file(directory / f"{stem}{suffix}") for suffix in TABLE_SUFFIXES
+             if (directory / f"{stem}{suffix}").exists()]
     if len(found) > 1:
-        raise InputError(f"both {found[0].name} and {found[1].name} exist; keep one", file=str(directory))
+        names = [p.name for p in found]
+        listed = f"both {names[0]} and {names[1]}" if len(names) == 2 else f"{', '.join(names[:-1])} and {names[-1]}"
+        raise InputError(f"{listed} exist; keep one", file=str(directory))
     if not found:
         if required:
-            raise InputError(f"no {stem}.csv or {stem}.parquet in the log folder", file=str(directory))
+            raise InputError(f"no {stem}.csv or {stem}.parquet (or {stem}.csv.gz) in the log folder",
+                             file=str(directory))
         return None
     return found[0]
 
@@ -546,324 +441,47 @@ def _read_table(path: Path, required: tuple[str, ...], *,
 
     CSV: the ``required`` columns are read as text (so IDs keep leading zeros and a bad
     time can be located), times and states trimmed of surrounding blanks (ID columns
-    are trimmed by :func:`_id_arrays`); other columns are inferred.  Blank lines count
-    as rows (as ``swarmtopo ingest`` counts them) and are dropped.  Only ``required``
-    columns (plus ``state``) are read unless ``keep_all``.
+    are trimmed by :func:`.tables.id_columns`); other columns are inferred.  Blank lines
+    count as rows (as ``swarmtopo ingest`` counts them) and are dropped.  Only
+    ``required`` columns (plus ``state``) are read unless ``keep_all``.
     """
-    if path.suffix == ".csv":
-        names = _csv_header(path)
+    csv = _is_csv(path)
+    if csv:
+        if path.suffix != ".gz" and _gzipped(path):
+            raise InputError(f"gzip-compressed: gunzip it first, or name it {path.name}.gz", file=str(path))
+        names = csv_header(path)
     else:
-        try:
-            names = pq.read_schema(path).names
-        except (pa.ArrowException, OSError) as exc:
-            raise InputError(f"cannot read Parquet file ({exc})", file=str(path)) from None
-    by_name = {}
-    for raw in names:
-        if raw.strip() in by_name and (keep_all or raw.strip() in (*required, "state")):
-            raise InputError("column appears twice", file=str(path), column=raw.strip())
-        by_name.setdefault(raw.strip(), raw)  # a name repeated among the ignored columns is never read
-    missing = [c for c in required if c not in by_name]
-    if missing:
-        raise InputError(f"missing column '{missing[0]}'; found columns: {', '.join(map(repr, by_name)) or 'none'}",
-                         file=str(path), column=missing[0])
+        pf = parquet_file(path)
+        names = pf.schema_arrow.names
+    by_name = find_columns(names, required, path, optional=("state",), every=keep_all)
     text = [c for c in dict.fromkeys((*required, "state")) if c in by_name]
     wanted = list(by_name) if keep_all else text
-    if path.suffix == ".csv":
-        table = _read_csv(path, [by_name[c] for c in wanted], {by_name[c] for c in text})
+    if csv:
+        table = read_csv(path, [by_name[c] for c in wanted], {by_name[c] for c in text})
     else:
-        try:
-            table = pq.read_table(path, columns=[by_name[c] for c in wanted])
-        except (pa.ArrowException, OSError) as exc:
-            raise InputError(f"cannot read Parquet file ({exc})", file=str(path)) from None
+        table = read_parquet(pf, [by_name[c] for c in wanted], path)
     out = {}
     for name in wanted:
         col = table.column(by_name[name]).combine_chunks()
         if pa.types.is_dictionary(col.type):
             col = col.dictionary_decode()
-        if path.suffix == ".csv" and name in text and name not in _ID_COLUMNS:
-            col = pc.utf8_trim_whitespace(col)
+        if csv and name in text and name not in _ID_COLUMNS:
+            col = trim(col)
         out[name] = col
     rows = np.arange(1, table.num_rows + 1)
-    if path.suffix == ".csv":
-        blank = np.logical_and.reduce([pc.equal(pc.utf8_length(pc.utf8_trim_whitespace(out[c])), 0)
-                                       .to_numpy(zero_copy_only=False) for c in text])
+    if csv:
+        blank = blank_rows([out[c] if c not in _ID_COLUMNS else trim(out[c]) for c in text])
         if blank.any():
             keep = pa.array(~blank)
             out, rows = {name: col.filter(keep) for name, col in out.items()}, rows[~blank]
     return out, rows
 
 
-def _csv_header(path: Path) -> list[str]:
+def _gzipped(path: Path) -> bool:
     try:
-        with open(path, "rb") as f:
-            refuse_binary(path, f.read(SNIFF_BYTES))
-        with pcsv.open_csv(path, read_options=pcsv.ReadOptions(block_size=1 << 16)) as reader:
-            return reader.schema.names
-    except UnicodeDecodeError as exc:
-        raise InputError(f"not UTF-8 text: the header row holds the byte 0x{exc.object[exc.start]:02x} "
-                         f"({exc.reason})", file=str(path)) from None
-    except pa.ArrowInvalid as exc:
-        raise _csv_problem(path, exc) from None
+        return is_gzip(path)
     except OSError as exc:
-        raise InputError(f"cannot read file ({_os_reason(exc)})", file=str(path)) from None
-
-
-def refuse_binary(path: Path, head: bytes) -> None:
-    """InputError naming ``path`` if ``head``, the first block of a text file, starts with
-    the byte-order mark of UTF-16 / UTF-32, is gzip, or holds a NUL byte (binary data: a
-    spreadsheet, an archive, UTF-16 without a byte-order mark)."""
-    for bom, encoding in _OTHER_ENCODINGS:
-        if head.startswith(bom):
-            raise InputError(f"not UTF-8 text: it starts with the byte-order mark of {encoding}; save it as UTF-8",
-                             file=str(path))
-    if head.startswith(GZIP_MAGIC):
-        raise InputError("gzip-compressed: gunzip it first", file=str(path))
-    nul = head.find(b"\0")
-    if nul >= 0:
-        line = head.count(b"\n", 0, nul) + 1
-        raise InputError(f"binary data, not text: line {line} holds a NUL byte (save the table as UTF-8 CSV)",
-                         file=str(path))
-
-
-def non_utf8_problem(blocks) -> str | None:
-    """Where the bytes ``blocks`` (an iterable of consecutive blocks) stop being UTF-8
-    text, as a message naming the line and the byte; None if they are UTF-8 throughout."""
-    line, tail = 1, b""
-    for block in itertools.chain(blocks, [b""]):  # b"": the end, where a cut character is an error
-        data = tail + block
-        try:
-            data.decode("utf-8")
-            tail = b""
-        except UnicodeDecodeError as exc:
-            if not (block and exc.reason == "unexpected end of data"):
-                line += data.count(b"\n", 0, exc.start)
-                return f"not UTF-8 text: line {line} holds the byte 0x{data[exc.start]:02x}; save the file as UTF-8"
-            data, tail = data[:exc.start], data[exc.start:]  # a character cut by the block's end
-        line += data.count(b"\n")
-    return None
-
-
-def _read_csv(path: Path, columns: list[str], text: set[str]) -> pa.Table:
-    convert = pcsv.ConvertOptions(include_columns=columns, column_types={c: pa.string() for c in text},
-                                  strings_can_be_null=False)
-    try:  # blank lines are read, so that rows are numbered as the file's data lines
-        return pcsv.read_csv(path, parse_options=pcsv.ParseOptions(ignore_empty_lines=False),
-                             convert_options=convert)
-    except pa.ArrowInvalid as exc:
-        if "invalid UTF8" in str(exc):
-            raise _not_utf8(path, columns, text) from None
-        raise _csv_problem(path, exc) from None
-    except OSError as exc:
-        raise InputError(f"cannot read file ({_os_reason(exc)})", file=str(path)) from None
-
-
-def _not_utf8(path: Path, columns: list[str], text: set[str]) -> InputError:
-    """The error for a text column that is not UTF-8, at its first bad row."""
-    try:
-        raw = pcsv.read_csv(path, parse_options=pcsv.ParseOptions(ignore_empty_lines=False),
-                            convert_options=pcsv.ConvertOptions(
-            include_columns=columns, column_types={c: pa.binary() for c in text}))
-    except pa.ArrowInvalid as exc:  # a row that does not parse either
-        return _csv_problem(path, exc)
-    bad = []
-    for name in columns:
-        if name in text:
-            col = raw.column(name).combine_chunks()
-            try:
-                col.cast(pa.string())
-            except pa.ArrowInvalid:
-                i = _first_uncastable(col, pa.string())
-                bad.append((i, name, col[i].as_py()))
-    if not bad:
-        return InputError("not UTF-8 text", file=str(path))
-    i, name, value = min(bad)
-    return InputError("not UTF-8 text", file=str(path), row=i + 1, column=name.strip(), value=value)
-
-
-def _csv_problem(path: Path, exc: Exception) -> InputError:
-    """pyarrow's parse error, with the 1-based data row and its text found by a
-    single-threaded re-read; or, in a file that is not UTF-8 throughout (pyarrow cannot
-    hand such a row to Python), the first byte that is not."""
-    try:
-        with open(path, "rb") as f:
-            not_utf8 = non_utf8_problem(iter(lambda: f.read(1 << 22), b""))
-    except OSError as err:
-        return InputError(f"cannot read file ({_os_reason(err)})", file=str(path))
-    if not_utf8:
-        return InputError(not_utf8, file=str(path))
-    bad = []
-
-    def record(row):
-        bad.append(row)
-        return "error"
-
-    try:
-        pcsv.read_csv(path, read_options=pcsv.ReadOptions(use_threads=False),
-                      parse_options=pcsv.ParseOptions(invalid_row_handler=record))
-    except pa.ArrowInvalid:
-        pass
-    if bad and bad[0].number is not None:  # number counts the header as row 1
-        return InputError(f"cannot parse CSV (expected {bad[0].expected_columns} columns, found "
-                          f"{bad[0].actual_columns})", file=str(path), row=bad[0].number - 1, value=bad[0].text)
-    # pyarrow >= 26.0.1 prefixes its own "Row #N: " (a file line, header included): dropped, as
-    # every message here counts data rows
-    reason = re.sub(r"^Row #\d+: ", "", str(exc).removeprefix("CSV parse error: "))
-    return InputError(f"cannot parse CSV ({reason})", file=str(path))
-
-
-def _number_column(col: pa.Array, path: Path, name: str, what: str, rows: np.ndarray) -> np.ndarray:
-    """float64 column; text is parsed, and the first bad value is located exactly (at its
-    source row: ``rows[i]`` is the 1-based data row of value ``i``)."""
-    kind = col.type
-    if pa.types.is_string(kind) or pa.types.is_large_string(kind):
-        try:
-            col = pc.cast(col, pa.float64())
-        except pa.ArrowInvalid:
-            i = _first_uncastable(col, pa.float64())
-            value = col[i].as_py()
-            problem = f"{what} is missing" if value == "" else f"{what} is not a number"
-            raise InputError(problem, file=str(path), row=int(rows[i]), column=name, value=value) from None
-    elif pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_decimal(kind):
-        coarse = coarse_time(col) if what == "time" else None
-        if coarse is not None:
-            i, problem = coarse
-            raise InputError(problem, file=str(path), row=int(rows[i]), column=name, value=col[i].as_py())
-        col = pc.cast(col, pa.float64(), safe=False)  # integers beyond 2^53 round; times that large are refused
-    elif pa.types.is_null(kind) and len(col) == 0:
-        col = pa.array([], pa.float64())
-    else:
-        raise InputError(f"{what} must be a number, not {kind}", file=str(path),
-                         row=int(rows[0]) if len(rows) else None, column=name,
-                         value=col[0].as_py() if len(col) else None)
-    if col.null_count:
-        i = int(np.argmax(col.is_null().to_numpy(zero_copy_only=False)))
-        raise InputError(f"{what} is missing", file=str(path), row=int(rows[i]), column=name)
-    return col.to_numpy(zero_copy_only=False)
-
-
-def coarse_time(col: pa.Array) -> tuple[int, str] | None:
-    """(index of the largest time, message) if ``col`` is a float16 / float32 column whose
-    spacing at its largest finite value exceeds ``MAX_TIME_RESOLUTION``; else None (the
-    column is read as float64, exactly)."""
-    if not (pa.types.is_float16(col.type) or pa.types.is_float32(col.type)):
-        return None
-    values = col.fill_null(0).to_numpy(zero_copy_only=False)
-    finite = np.isfinite(values)
-    if not finite.any():
-        return None
-    i = int(np.argmax(np.where(finite, np.abs(values), -1)))
-    spacing = float(np.spacing(np.abs(values[i])))
-    if spacing <= MAX_TIME_RESOLUTION:
-        return None
-    return i, (f"a {col.type} time column tells times apart only to {spacing:g} s at its largest value (the "
-               f"file's times were rounded when written); write them as float64 or integers")
-
-
-def _first_uncastable(col: pa.Array, to_type) -> int:
-    """Index of the first value that does not cast; bisection, so O(n) vectorised work."""
-    lo, hi = 0, len(col)  # invariant: the first bad value lies in col[lo:hi]
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        try:
-            pc.cast(col.slice(lo, mid - lo), to_type)
-        except pa.ArrowInvalid:
-            hi = mid
-        else:
-            lo = mid
-    return lo
-
-
-def _id_arrays(columns: list[tuple[pa.Array, Path, str, np.ndarray]], *, declared) -> list:
-    """Give all ID columns ``(column, file, name, source rows)`` of a folder one kind:
-    int64 numpy arrays, or pyarrow text.
-
-    Integer if every column is integer-typed (floats are left to the log's integrality
-    check) or, in CSV, holds only IDs written as integers (:func:`integer_ids`), and meta
-    declares no text IDs (``declared``: its ``agent_ids``).  Text columns of a Parquet
-    file are text whatever they hold; a column that cannot be read as text (a list, a
-    struct) is refused.  A CSV ID is trimmed of surrounding blanks unless ``declared``
-    lists it as written (so that a log's padded text IDs read back exactly); two text IDs
-    that trimming would merge are refused.
-    """
-    declared = list(declared or [])
-    kept = pa.array([str(v) for v in declared], pa.string())
-    checked = []  # (column, is numeric, from a CSV file)
-    written = []  # (CSV column as written, file, name, source rows)
-    for col, path, name, rows in columns:
-        if col.null_count:
-            i = int(np.argmax(col.is_null().to_numpy(zero_copy_only=False)))
-            raise InputError("agent ID is missing", file=str(path), row=int(rows[i]), column=name)
-        numeric = pa.types.is_integer(col.type) or pa.types.is_floating(col.type)
-        if not numeric:
-            try:
-                col = pc.cast(col, pa.string())
-            except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
-                raise InputError(f"agent IDs must be integers or text, not {col.type}", file=str(path),
-                                 column=name) from None
-        csv = path.suffix == ".csv"
-        if csv:
-            written.append((col, path, name, rows))
-            col = _trimmed_ids(col, kept)
-        checked.append((col, numeric, csv))
-    declared_text = any(isinstance(v, str) for v in declared)
-    if not declared_text and all(numeric or csv for _, numeric, csv in checked):  # CSV has no types
-        texts = integer_ids([col for col, numeric, _ in checked if not numeric])
-        if texts is not None:
-            texts = iter(texts)
-            try:
-                ints = [col if pa.types.is_floating(col.type) else pc.cast(col, pa.int64()) if numeric else next(texts)
-                        for col, numeric, _ in checked]
-            except pa.ArrowInvalid:  # an unsigned integer beyond int64: every ID is text
-                pass
-            else:
-                return [col.to_numpy(zero_copy_only=False) for col in ints]
-    refuse_merged_by_trimming(written, kept)
-    return [pc.cast(col, pa.string()) if numeric else col for col, numeric, _ in checked]
-
-
-def _trimmed_ids(col: pa.Array, kept: pa.Array) -> pa.Array:
-    """CSV ID text trimmed of surrounding blanks, except the IDs in ``kept`` (as written)."""
-    return pc.if_else(pc.is_in(col, value_set=kept), col, pc.utf8_trim_whitespace(col))
-
-
-def refuse_merged_by_trimming(written: list[tuple[pa.Array, Path, str, np.ndarray]], kept: pa.Array) -> None:
-    """InputError at the first padded spelling of an ID that another spelling in the CSV
-    ID columns ``written`` also trims to: trimming would merge two distinct text IDs."""
-    if not written:
-        return
-    spellings = pc.unique(pa.concat_arrays([col for col, *_ in written]))
-    ids = _trimmed_ids(spellings, kept)
-    enc = pc.dictionary_encode(ids)
-    if len(enc.dictionary) == len(spellings):
-        return
-    index = enc.indices.to_numpy(zero_copy_only=False)
-    merged = np.bincount(index, minlength=len(enc.dictionary))[index] > 1
-    padded = spellings.filter(pa.array(merged & ~pc.equal(spellings, ids).to_numpy(zero_copy_only=False)))
-    for col, path, name, rows in written:
-        hit = pc.is_in(col, value_set=padded).to_numpy(zero_copy_only=False)
-        if hit.any():
-            i = int(np.argmax(hit))
-            trimmed = col[i].as_py().strip()
-            raise InputError(f"agent ID differs from the ID {trimmed!r} only in the blanks around it, which a CSV "
-                             f"field drops: the two would merge into one agent (spell each agent one way, or use "
-                             f"Parquet, which keeps blanks)", file=str(path), row=int(rows[i]), column=name,
-                             value=col[i].as_py())
-
-
-def integer_ids(columns: list[pa.Array]) -> list[pa.Array] | None:
-    """Text ID columns as int64, if every ID is written as an integer (``12``, or ``12.0``
-    for the same agent; not ``012`` or ``-0``) and fits int64; else None.  Exact: the
-    integer part is parsed as text, never through a float.  The text work is done once per
-    distinct ID."""
-    encoded = [pc.dictionary_encode(col) for col in columns]
-    if not all(pc.all(pc.match_substring_regex(enc.dictionary, _INTEGER_TEXT)).as_py() is not False
-               for enc in encoded):
-        return None
-    try:
-        return [pc.take(pc.cast(pc.replace_substring_regex(enc.dictionary, r"\.0+$", ""), pa.int64()), enc.indices)
-                for enc in encoded]
-    except pa.ArrowInvalid:  # beyond int64: every ID is text
-        return None
+        raise read_error(path, exc) from None
 
 
 def _id_numpy(ids, path: Path, column: str, rows: np.ndarray) -> np.ndarray:
@@ -887,9 +505,9 @@ NUMBER_META_KEYS = {"r_d": "detection radius, mm", "v_c": "random-walk speed, mm
 
 def _read_meta(path: Path) -> dict:
     """meta.json as a dict ({} if absent), with ``static`` and the ID keys checked."""
-    _not_a_folder(path)
-    if not path.is_file():
+    if not path.exists():
         return {}
+    existing_file(path)
     meta = read_json(path)
     if not isinstance(meta, dict):
         raise InputError(f"meta.json must hold a JSON object, not {type(meta).__name__}", file=str(path))

@@ -4,7 +4,10 @@ Every reader returns an :class:`~.log.EncounterLog` and an :class:`IngestReport`
 prints or writes.  Files are read in blocks (pyarrow's streaming CSV reader, Parquet
 record batches, or 4 MiB blocks of text split into lines in C), every check is a
 vectorised pyarrow / numpy operation, and agent IDs stay pyarrow text until they are
-dictionary-encoded: 10^6 rows never become 10^6 Python objects.
+dictionary-encoded: 10^6 rows never become 10^6 Python objects.  Bytes, UTF-8, CSV
+headers and agent IDs are handled by :mod:`.tables`, as for log folders; this module
+adds what is particular to traces (malformed lines skipped with ``skip_bad``, windows
+merged, connections matched).
 
 Formats
 -------
@@ -35,7 +38,8 @@ A line is malformed if it has the wrong number of fields, a time that is not a
 finite number >= 0 (>= w for SocioPatterns), an empty ID, an ID holding a NUL
 character (it would merge with the ID without it), ``a == b``, a ONE state
 other than up / down, or text that is not UTF-8 (a CSV file that is not UTF-8 is
-refused whole: pyarrow cannot hand such a row back to be skipped).  Without
+refused whole: pyarrow cannot hand such a row back to be skipped; the message names
+the line and column of its first such byte).  Without
 ``skip_bad`` the first one raises an :class:`~.errors.InputError` naming the file, the
 line (text formats; for CSV and Parquet the 1-based data row, header not counted), the
 field and the value.
@@ -45,9 +49,6 @@ lines are not malformed: they are counted and ignored.
 
 from __future__ import annotations
 
-import gzip
-import itertools
-import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -55,18 +56,18 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.csv as pcsv
-import pyarrow.parquet as pq
 
 from ..errors import InputError, SwarmtopoError
-from .logs import (GZIP_MAGIC, SNIFF_BYTES, coarse_time, integer_ids, non_utf8_problem, refuse_binary,
-                 refuse_merged_by_trimming)
 from ..log import MAX_TIME, NUL_ID, TOO_LATE, EncounterLog
+from .tables import (BLOCK, IdColumn, blank_rows, blocks, check_text, coarse_time, csv_header, existing_file,
+                     find_columns, id_columns, integer_ids, not_utf8, not_utf8_reason, open_bytes, parquet_file,
+                     read_error, trim)
 
 FORMATS: tuple[str, ...] = ("csv", "parquet", "sociopatterns", "one")
 SOCIOPATTERNS_WINDOW = 20.0
 """Seconds of one SocioPatterns contact window (the sensors' 20 s resolution)."""
 
-_BLOCK = 1 << 22  # bytes per block of a streamed file
+_BLOCK = BLOCK  # bytes per block of a streamed file
 _EXAMPLES = 5  # messages of skipped lines kept in the report
 _NUMBER = r"^[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?$"
 
@@ -104,8 +105,8 @@ class IngestReport:
                 "skipped_lines": self.skipped, "skipped_examples": list(self.examples), **self.counts}
 
 
-def ingest(path, fmt: str, *, skip_bad: bool = False, time_column: str = "t", a_column: str = "a",
-           b_column: str = "b", window: float = SOCIOPATTERNS_WINDOW) -> tuple[EncounterLog, IngestReport]:
+def read_trace(path, fmt: str, *, skip_bad: bool = False, time_column: str = "t", a_column: str = "a",
+               b_column: str = "b", window: float = SOCIOPATTERNS_WINDOW) -> tuple[EncounterLog, IngestReport]:
     """Read a proximity trace of format ``fmt`` (one of :data:`FORMATS`).
 
     ``time_column, a_column, b_column`` name the columns of ``csv`` / ``parquet``;
@@ -126,15 +127,15 @@ def ingest(path, fmt: str, *, skip_bad: bool = False, time_column: str = "t", a_
 def read_table_trace(path, *, fmt: str = "csv", skip_bad: bool = False, time_column: str = "t",
                      a_column: str = "a", b_column: str = "b") -> tuple[EncounterLog, IngestReport]:
     """A CSV or Parquet table, one encounter ``(t, a, b)`` per row."""
-    path = _existing(path)
+    path = existing_file(path, "trace file")
     names = {"t": time_column, "a": a_column, "b": b_column}
     if len(set(names.values())) < 3:
         raise SwarmtopoError(f"the time and the two ID columns must be three different columns, not "
                              f"{time_column!r}, {a_column!r}, {b_column!r}")
     rows = _Rows(str(path), skip_bad)
     for line, written in (_csv_batches(path, names, rows) if fmt == "csv" else _parquet_batches(path, names, rows)):
-        cols = {k: _trim(v) for k, v in written.items()} if fmt == "csv" else written
-        blank = _blank_row(cols) if fmt == "csv" else np.zeros(len(line), bool)  # Parquet has no blank lines
+        cols = {k: trim(v) for k, v in written.items()} if fmt == "csv" else written
+        blank = blank_rows(cols.values()) if fmt == "csv" else np.zeros(len(line), bool)  # Parquet has no blank lines
         rows.counts["blank_lines"] += int(blank.sum())
         line, cols, written = line[~blank], *({k: v.filter(pa.array(~blank)) for k, v in c.items()}
                                               for c in (cols, written))
@@ -143,8 +144,8 @@ def read_table_trace(path, *, fmt: str = "csv", skip_bad: bool = False, time_col
         # IDs are kept as written: trimming is checked not to merge two of them
         rows.keep(ok, line, t=t[ok], a=written["a"].filter(pa.array(ok)), b=written["b"].filter(pa.array(ok)))
     t, a, b, line = rows.columns()
-    if fmt == "csv":
-        a, b = _trimmed_ids(a, b, line, names, rows.file)
+    if fmt == "csv":  # trimmed, and two IDs that trimming would merge refused
+        a, b = id_columns([IdColumn(col, path, names[key], line, csv=True) for key, col in (("a", a), ("b", b))])
     columns = {"time": names["t"], "a": names["a"], "b": names["b"]}
     if rows.time_type is not None:
         columns["time_type"] = rows.time_type
@@ -157,7 +158,7 @@ def read_sociopatterns(path, *, window: float = SOCIOPATTERNS_WINDOW,
     """SocioPatterns ``t i j Ci Cj`` lines; consecutive windows of a pair merge."""
     if not (np.isfinite(window) and window > 0):
         raise SwarmtopoError(f"the window must be a positive number of seconds, not {window!r}")
-    path = _existing(path)
+    path = existing_file(path, "trace file")
     rows = _Rows(str(path), skip_bad)
     for line, fields, n in _text_batches(path, rows):
         ok = _field_count_ok(n, (3, 5), fields, line, rows, "t i j Ci Cj (or t i j)")
@@ -184,7 +185,7 @@ def read_sociopatterns(path, *, window: float = SOCIOPATTERNS_WINDOW,
 
 def read_one(path, *, skip_bad: bool = False) -> tuple[EncounterLog, IngestReport]:
     """ONE simulator connection events ``time CONN a b up|down``; an encounter per ``up``."""
-    path = _existing(path)
+    path = existing_file(path, "trace file")
     rows = _Rows(str(path), skip_bad)
     rows.counts["other_events"] = 0
     for line, fields, n in _text_batches(path, rows):
@@ -263,12 +264,17 @@ def _codes(a: pa.Array, b: pa.Array) -> tuple[np.ndarray, np.ndarray, pa.Array]:
 
 
 def _classes(ids: pa.Array, code_a, code_b, ci: pa.Array, cj: pa.Array, line, file) -> dict[str, str]:
-    """``{id: class}`` from the lines that carry classes; an ID with two classes is refused."""
+    """``{id: class}`` from the lines that carry classes.  An ID given two classes is
+    refused at the first line that contradicts its earlier class (lines in file order,
+    ``Ci`` before ``Cj`` within a line)."""
     has = ~pc.is_null(ci).to_numpy(zero_copy_only=False)
-    codes = np.r_[code_a[has], code_b[has]]
-    if not len(codes):
+    n = int(has.sum())
+    if not n:
         return {}
-    labels = pa.concat_arrays([ci.filter(pa.array(has)), cj.filter(pa.array(has))])
+    lines = np.r_[line[has], line[has]]
+    order = np.lexsort((np.repeat([0, 1], n), lines))  # file order: by line, then Ci before Cj
+    codes = np.r_[code_a[has], code_b[has]][order]
+    labels = pa.concat_arrays([ci.filter(pa.array(has)), cj.filter(pa.array(has))]).take(pa.array(order))
     enc = pc.dictionary_encode(labels)
     cls = enc.indices.to_numpy(zero_copy_only=False).astype(np.int64)
     agents, first = np.unique(codes, return_index=True)
@@ -276,12 +282,12 @@ def _classes(ids: pa.Array, code_a, code_b, ci: pa.Array, cj: pa.Array, line, fi
     expected[agents] = cls[first]
     clash = cls != expected[codes]
     if clash.any():
-        lines = np.r_[line[has], line[has]]
-        k = int(np.flatnonzero(clash)[np.argmin(lines[clash])])  # the earliest line
-        names = ("Ci", "Cj")[int(k >= has.sum())]
+        k = int(np.argmax(clash))  # the first in file order
+        earlier = first[np.searchsorted(agents, codes[k])]
         raise InputError(f"agent {ids[codes[k]].as_py()!r} already has class "
-                         f"{enc.dictionary[expected[codes[k]]].as_py()!r}", file=file, row=int(lines[k]),
-                         column=names, value=labels[k].as_py())
+                         f"{enc.dictionary[expected[codes[k]]].as_py()!r} (row {int(lines[order[earlier]])}); an "
+                         f"agent has one class", file=file, row=int(lines[order[k]]),
+                         column=("Ci", "Cj")[int(order[k] >= n)], value=labels[k].as_py())
     keys = ids.take(pa.array(agents)).to_pylist()
     values = enc.dictionary.take(pa.array(cls[first])).to_pylist()
     return dict(zip(map(str, keys), values))
@@ -296,9 +302,10 @@ def _build(t, a, b, line, rows: "_Rows", fmt: str, meta_extra: dict) -> Encounte
         report = rows.report(fmt)
         raise InputError(f"no encounters in the trace ({report.lines} lines read, {report.skipped} skipped as "
                          f"malformed, {report.counts.get('blank_lines', 0)} blank)", file=rows.file)
-    as_int = integer_ids([a, b])
-    if as_int is not None:
-        a, b = (c.to_numpy(zero_copy_only=False) for c in as_int)
+    if isinstance(a, pa.Array):  # text IDs; CSV IDs come decided by id_columns
+        as_int = integer_ids([a, b])
+        if as_int is not None:
+            a, b = (c.to_numpy(zero_copy_only=False) for c in as_int)
     meta = {"units": {"time": "s"}, "ingest": {**rows.report(fmt).as_meta(), **meta_extra}}
     return EncounterLog.from_records(t, a, b, meta=meta, source={"events": rows.file}, event_rows=line)
 
@@ -386,27 +393,15 @@ def _concat(parts) -> pa.Array:
 
 
 # -- reading blocks -----------------------------------------------------------------------------
-def _existing(path) -> Path:
-    path = Path(path)
-    if path.is_dir():
-        raise InputError("is a folder, not a trace file", file=str(path))
-    if path.exists() and not path.is_file():
-        raise InputError("is not a regular file (a pipe, socket or device: a trace is read more than once, "
-                         "so save it to a file first)", file=str(path))
-    if not path.is_file():
-        raise InputError("trace file not found", file=str(path))
-    return path
-
-
 def _csv_batches(path: Path, names: dict[str, str], rows: _Rows):
     """(data row numbers, {t, a, b: text columns, untrimmed}) per block of a CSV file.
 
     Single-threaded parsing, so rows that do not split into the header's columns reach
     the handler in order with their line numbers; blank lines arrive as empty rows.
     """
-    _check_csv_text(path)  # so that pyarrow can hand every row to the handler as text
-    header = _csv_header(path)
-    names = {key: _column_of(header, col, path) for key, col in names.items()}
+    check_text(path)  # so that pyarrow can hand every row to the handler as text
+    header = find_columns(csv_header(path), list(dict.fromkeys(names.values())), path)
+    names = {key: header[col] for key, col in names.items()}
     bad_rows: list[int] = []  # data rows the parser could not split, all so far
 
     def invalid(row) -> str:
@@ -418,7 +413,7 @@ def _csv_batches(path: Path, names: dict[str, str], rows: _Rows):
     convert = pcsv.ConvertOptions(include_columns=list(dict.fromkeys(names.values())),
                                   column_types={c: pa.string() for c in names.values()}, strings_can_be_null=False)
     try:
-        reader = pcsv.open_csv(_csv_bytes(path), read_options=pcsv.ReadOptions(use_threads=False, block_size=_BLOCK),
+        reader = pcsv.open_csv(open_bytes(path), read_options=pcsv.ReadOptions(use_threads=False, block_size=_BLOCK),
                                parse_options=pcsv.ParseOptions(invalid_row_handler=invalid, ignore_empty_lines=False),
                                convert_options=convert)
         delivered = 0
@@ -434,62 +429,14 @@ def _csv_batches(path: Path, names: dict[str, str], rows: _Rows):
     except pa.ArrowInvalid as exc:
         raise InputError(f"cannot parse CSV ({exc})", file=str(path)) from None
     except OSError as exc:  # a truncated or corrupt .gz
-        raise InputError(f"cannot read the file ({exc})", file=str(path)) from None
-
-
-def _csv_bytes(path: Path) -> pa.NativeFile:
-    """The CSV file's bytes: gunzipped if it is gzip, by content as the text formats (other
-    compressions by name, as pyarrow detects them)."""
-    with open(path, "rb") as f:
-        gzipped = f.read(2) == GZIP_MAGIC
-    return pa.input_stream(str(path), compression="gzip" if gzipped else "detect")
-
-
-def _check_csv_text(path: Path) -> None:
-    """Refuse a CSV file that is binary (a NUL byte in its first block) or not UTF-8 throughout.
-
-    pyarrow decodes a row its parser cannot split before handing it to Python, and fails
-    on one that is not UTF-8: so a CSV trace is checked whole first (one pass in C).
-    """
-    try:
-        with _csv_bytes(path) as f:
-            head = f.read(SNIFF_BYTES)
-            refuse_binary(path, head)
-            problem = non_utf8_problem(itertools.chain([head], iter(lambda: f.read(_BLOCK), b"")))
-    except (OSError, pa.ArrowInvalid) as exc:  # a truncated or corrupt .gz
-        raise InputError(f"cannot read the file ({exc})", file=str(path)) from None
-    if problem:
-        raise InputError(problem, file=str(path))
-
-
-def _column_of(header: list[str], name: str, path: Path) -> str:
-    """The header's column called ``name`` (blanks round a header name ignored); a name
-    missing or found twice is refused."""
-    found = [h for h in header if h.strip() == name]
-    if len(found) != 1:
-        problem = "missing column" if not found else "column appears twice:"
-        raise InputError(f"{problem} {name!r}; found columns: {', '.join(map(repr, header))}",
-                         file=str(path), column=name)
-    return found[0]
-
-
-def _csv_header(path: Path) -> list[str]:
-    try:
-        with pcsv.open_csv(_csv_bytes(path), read_options=pcsv.ReadOptions(block_size=1 << 16),
-                           parse_options=pcsv.ParseOptions(invalid_row_handler=lambda row: "skip")) as reader:
-            return reader.schema.names
-    except (pa.ArrowInvalid, OSError) as exc:
-        raise InputError(f"cannot read the CSV header ({exc})", file=str(path)) from None
+        raise read_error(path, exc) from None
 
 
 def _parquet_batches(path: Path, names: dict[str, str], rows: _Rows):
     """(row numbers, {t, a, b}) per record batch; IDs as text, times as they are."""
-    try:
-        pf = pq.ParquetFile(path)
-    except (pa.ArrowException, OSError) as exc:
-        raise InputError(f"cannot read Parquet file ({exc})", file=str(path)) from None
-    schema = pf.schema_arrow
-    names = {key: _column_of(schema.names, col, path) for key, col in names.items()}
+    pf = parquet_file(path)
+    header = find_columns(pf.schema_arrow.names, list(dict.fromkeys(names.values())), path)
+    names = {key: header[col] for key, col in names.items()}
     start = 0
     for batch in pf.iter_batches(batch_size=1 << 18, columns=list(dict.fromkeys(names.values()))):
         cols = {}
@@ -544,107 +491,51 @@ def _text_batches(path: Path, rows: _Rows):
     blank lines are counted and dropped here.
     """
     line_no = 0
-    with _open_text(path) as f:
-        tail = _read(f, 3, path)
-        tail = tail[3:] if tail == b"\xef\xbb\xbf" else tail  # a UTF-8 byte order mark
-        while True:
-            block = _read(f, _BLOCK, path)
-            data = tail + block
-            if block:
-                # cut after the last line end; a final \r waits: a \n may follow in the next block
-                cut = max(data.rfind(b"\n"), data.rfind(b"\r", 0, len(data) - 1)) + 1
-                data, tail = data[:cut], data[cut:]
-                if not data:
-                    continue
-            elif not data:
-                return
-            data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")  # CRLF and CR-only line ends
-            lines = pc.split_pattern(pa.array([data], pa.large_binary()), b"\n").flatten()
-            if block or data.endswith(b"\n"):
-                lines = lines.slice(0, len(lines) - 1)  # after the final newline: nothing
-            numbers = np.arange(line_no + 1, line_no + len(lines) + 1)
-            line_no += len(lines)
-            rows.lines += len(lines)
-            lines, numbers = _utf8_lines(lines, numbers, rows)
-            text = pc.utf8_trim_whitespace(lines)
-            blank = pc.equal(pc.utf8_length(text), 0).to_numpy(zero_copy_only=False)
-            rows.counts["blank_lines"] += int(blank.sum())
-            text, numbers = text.filter(pa.array(~blank)), numbers[~blank]
-            fields = pc.utf8_split_whitespace(text)
-            yield numbers, fields, pc.list_value_length(fields).to_numpy(zero_copy_only=False).astype(np.int64)
-            if not block:
-                return
-
-
-def _read(f, size: int, path: Path) -> bytes:
-    """``f.read(size)``; a truncated or corrupt gzip stream is refused naming the file."""
-    try:
-        return f.read(size)
-    except (OSError, EOFError, zlib.error) as exc:
-        raise InputError(f"cannot decompress the gzip file ({exc})", file=str(path)) from None
-
-
-def _open_text(path: Path):
-    """The file's bytes, gunzipped if it is gzip (by its magic number, not its name)."""
-    with open(path, "rb") as f:
-        gzipped = f.read(2) == b"\x1f\x8b"
-    return gzip.open(path, "rb") if gzipped else open(path, "rb")
+    chunks = blocks(path, _BLOCK)
+    tail = b""
+    for block in chunks:  # the first 3 bytes, for a byte order mark
+        tail += block
+        if len(tail) >= 3:
+            break
+    tail = tail[3:] if tail.startswith(b"\xef\xbb\xbf") else tail  # a UTF-8 byte order mark
+    while True:
+        block = next(chunks, b"")
+        data = tail + block
+        if block:
+            # cut after the last line end; a final \r waits: a \n may follow in the next block
+            cut = max(data.rfind(b"\n"), data.rfind(b"\r", 0, len(data) - 1)) + 1
+            data, tail = data[:cut], data[cut:]
+            if not data:
+                continue
+        elif not data:
+            return
+        data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")  # CRLF and CR-only line ends
+        lines = pc.split_pattern(pa.array([data], pa.large_binary()), b"\n").flatten()
+        if block or data.endswith(b"\n"):
+            lines = lines.slice(0, len(lines) - 1)  # after the final newline: nothing
+        numbers = np.arange(line_no + 1, line_no + len(lines) + 1)
+        line_no += len(lines)
+        rows.lines += len(lines)
+        lines, numbers = _utf8_lines(lines, numbers, rows)
+        text = pc.utf8_trim_whitespace(lines)
+        blank = pc.equal(pc.utf8_length(text), 0).to_numpy(zero_copy_only=False)
+        rows.counts["blank_lines"] += int(blank.sum())
+        text, numbers = text.filter(pa.array(~blank)), numbers[~blank]
+        fields = pc.utf8_split_whitespace(text)
+        yield numbers, fields, pc.list_value_length(fields).to_numpy(zero_copy_only=False).astype(np.int64)
+        if not block:
+            return
 
 
 def _utf8_lines(lines: pa.Array, numbers: np.ndarray, rows: _Rows):
-    """Lines as text; a line that is not UTF-8 is malformed."""
-    bad = _not_utf8(lines)
+    """Lines as text; a line that is not UTF-8 is malformed (its first bad byte named)."""
+    bad = not_utf8(lines)
     for i in np.flatnonzero(bad):
-        rows.skip_raw(int(numbers[i]), "not UTF-8 text", lines[int(i)].as_py())
+        rows.skip_raw(int(numbers[i]), not_utf8_reason(lines[int(i)].as_py()), None)
     return pc.cast(lines.filter(pa.array(~bad)), pa.string()), numbers[~bad]
 
 
-def _not_utf8(col: pa.Array) -> np.ndarray:
-    """Mask of the binary values that are not UTF-8: one cast if all are, else each
-    value of the block decoded once (a file saved in Latin-1 costs O(n), not O(n^2))."""
-    try:
-        pc.cast(col, pa.large_string())
-        return np.zeros(len(col), bool)
-    except pa.ArrowInvalid:
-        return np.fromiter((v is not None and not _decodes(v) for v in col.to_pylist()), bool, count=len(col))
-
-
-def _decodes(value: bytes) -> bool:
-    try:
-        value.decode("utf-8")
-        return True
-    except UnicodeDecodeError:
-        return False
-
-
 # -- vectorised checks ------------------------------------------------------------------------
-def _trim(col) -> pa.Array:
-    if isinstance(col, pa.ChunkedArray):
-        col = col.combine_chunks()
-    return pc.utf8_trim_whitespace(col.fill_null(""))
-
-
-def _trimmed_ids(a: pa.Array, b: pa.Array, line, names: dict[str, str], file: str) -> tuple[pa.Array, pa.Array]:
-    """CSV ID columns trimmed of surrounding blanks; text IDs that differ only in those
-    blanks (``B7`` and ``B7 ``) are refused rather than merged (integers are numbers:
-    `` 7`` is 7)."""
-    trimmed = _trim(a), _trim(b)
-    if integer_ids(list(trimmed)) is None:
-        refuse_merged_by_trimming([(a, Path(file), names["a"], line), (b, Path(file), names["b"], line)],
-                                  pa.array([], pa.string()))
-    return trimmed
-
-
-def _blank_row(cols: dict[str, pa.Array]) -> np.ndarray:
-    """Rows whose every column is empty text (a non-text column is never blank)."""
-    blank = np.ones(len(cols["a"]), bool)
-    for col in cols.values():
-        if not pa.types.is_string(col.type):
-            return np.zeros(len(blank), bool)
-        blank &= pc.equal(pc.utf8_length(col), 0).to_numpy(zero_copy_only=False)
-    return blank
-
-
 def _field(fields: pa.Array, k: int, present: np.ndarray) -> pa.Array:
     """Field ``k`` of every line, null where ``present`` is False (lines too short)."""
     safe = pc.if_else(pa.array(present), fields, pa.scalar([""] * (k + 1), fields.type))

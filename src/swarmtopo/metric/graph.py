@@ -281,6 +281,49 @@ def build_graph(log: EncounterLog, metric: str = "plain", *,
         Unknown metric, no events (in the window), a negative hop cost, a diffusion
         time that is not > 0 or a negative wall-following weight.
     """
+    return weighted_chains(log, metric, window=window, hop_cost=hop_cost, diffusion_time=diffusion_time,
+                           wall_follow_weight=wall_follow_weight).graph()
+
+
+@dataclass(frozen=True)
+class WeightedChains:
+    """The chain graph's edges with their final weights (metric, D_tau, wall following,
+    h), before zero-weight joins are merged: what a graph of any time window is cut from.
+
+    ``first < second`` index the (windowed) events, which are sorted by time, so the
+    events of a window [t0, t1] are one slice of them, and its chain edges are exactly
+    the edges with both ends in that slice: an agent's consecutive events inside a
+    window are consecutive in the whole log.  Each edge's weight depends on its two
+    events and the whole log's status only, so :meth:`graph` of a window is the graph
+    ``build_graph(log, window=...)`` builds, bit for bit.
+    """
+
+    first: np.ndarray
+    second: np.ndarray
+    weight: np.ndarray
+    t: np.ndarray
+    event_index: np.ndarray
+    metric: str
+
+    def graph(self, span: tuple[float, float] | None = None) -> EncounterGraph:
+        """The encounter graph of the events with t0 <= t <= t1 (``span``; None: all)."""
+        if span is None:
+            return _contract(self.t, self.first, self.second, self.weight, self.event_index, self.metric)
+        lo = int(np.searchsorted(self.t, span[0], side="left"))
+        hi = int(np.searchsorted(self.t, span[1], side="right"))
+        if hi <= lo:
+            raise InputError(f"no encounter events in the window [{exact_time(span[0])}, {exact_time(span[1])}] s")
+        inside = (self.first >= lo) & (self.second < hi)
+        return _contract(self.t[lo:hi], self.first[inside] - lo, self.second[inside] - lo, self.weight[inside],
+                         self.event_index[lo:hi], self.metric)
+
+
+def weighted_chains(log: EncounterLog, metric: str = "plain", *,
+                    window: tuple[float | None, float | None] | None = None,
+                    hop_cost: float = 0.0, diffusion_time: float = np.inf,
+                    wall_follow_weight: float | None = None) -> WeightedChains:
+    """The chain edges of ``log`` (``window`` applied) weighted as :func:`build_graph`
+    describes, ready to be cut into the graphs of time windows; raises as it does."""
     chains = chain_edges(log, metric, window)
     hop_cost = non_negative("hop cost", hop_cost)
     if wall_follow_weight is None:
@@ -291,7 +334,7 @@ def build_graph(log: EncounterLog, metric: str = "plain", *,
                                chains.weight)
         weight = diffusive_weight(chains.weight - following, diffusion_time) + c * following
     weight = weight + hop_cost
-    return _contract(chains.t, chains.first, chains.second, weight, chains.event_index, metric)
+    return WeightedChains(chains.first, chains.second, weight, chains.t, chains.event_index, metric)
 
 
 def diffusive_weight(weight: np.ndarray, diffusion_time: float) -> np.ndarray:
@@ -322,7 +365,7 @@ def chain_edges(log: EncounterLog, metric: str = "plain",
     """Consecutive events of each agent in the (windowed) log and their weights under
     ``metric`` (no hop cost), grouped by agent in time order; raises as :func:`build_graph`."""
     _check_metric(metric)
-    start, stop = _window_slice(log, window)
+    start, stop = event_slice(log, window)
     t, a, b = log.t[start:stop], log.a[start:stop], log.b[start:stop]
     pair_agent, first, second = _agent_chains(a, b)
     weight = t[second] - t[first]
@@ -386,7 +429,7 @@ def literal_distances(log: EncounterLog, metric: str,
         Distances between the (windowed) events, +inf between disconnected ones.
     """
     _check_metric(metric)
-    start, stop = _window_slice(log, window)
+    start, stop = event_slice(log, window)
     t, a, b = log.t[start:stop], log.a[start:stop], log.b[start:stop]
     n = len(t)
     weights = np.full((n, n), np.inf)
@@ -412,7 +455,7 @@ def _check_metric(metric) -> None:
                          column="metric", value=metric)
 
 
-def _window_slice(log: EncounterLog, window) -> tuple[int, int]:
+def event_slice(log: EncounterLog, window) -> tuple[int, int]:
     """Events t0 <= t <= t1 as a slice of the time-sorted log; raises if none."""
     try:
         t0, t1 = (None, None) if window is None else window

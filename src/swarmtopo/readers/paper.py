@@ -39,11 +39,7 @@ confidence is the pipeline's (:mod:`swarmtopo.readers.beta0`).
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
-from functools import lru_cache
-from importlib import resources
-from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
@@ -53,9 +49,11 @@ from sklearn.base import BaseEstimator
 from sklearn.linear_model import LogisticRegression
 
 from .. import __version__
-from .._validate import check_format, file_calibration
+from .._json import read_json, write_json
+from .._validate import check_format
 from ..errors import InputError, SwarmtopoError
 from ..topology.persistence import Diagram
+from .base import WindowReader, median_vote, product_confidence, vote
 
 CLASSIFIER_FORMAT = "swarmtopo-classifier/1"
 CALIBRATION_KEYS = ("intercept", "margin", "gap")
@@ -63,9 +61,9 @@ CALIBRATION_KEYS = ("intercept", "margin", "gap")
 MAX_MARGIN = 5.0
 """Cap of the log-ratio margin (a bar e^5 ~ 150 times off the threshold is as sure as it gets)."""
 PAPER_THETA = {1: (0.5, 0.7, 3.7)}
-"""The paper's published Theta*_1 = (q_1, Delta_1, tau_1), F = 0.03 on its training set."""
-PRESETS = ("default", "trace", "gated", "paper", "paper-form")
-"""Classifiers shipped with the package (``load_classifier(name)``)."""
+"""The paper's published Theta*_1 = (q_1, Delta_1, tau_1), F = 0.03 on its training set
+(:func:`published_paper_classifier`; the ``paper`` preset is this form trained on our random
+environments the paper's way)."""
 
 Q_GRID = tuple(np.round(np.arange(0.05, 0.951, 0.05), 2))
 DELTA_GRID = (0.0,) + tuple(np.round(np.geomspace(0.01, 10.0, 16), 4))
@@ -135,7 +133,7 @@ class Theta:
         return {"q": self.q, "delta": self.delta, "tau": self.tau}
 
 
-class BettiClassifier(BaseEstimator):
+class BettiClassifier(WindowReader, BaseEstimator):
     """The paper's Betti function beta_hat_n(q_n, Delta_n, tau_n), fitted by minimising F.
 
     scikit-learn conventions: ``__init__`` only stores, :meth:`fit` returns self,
@@ -252,18 +250,18 @@ class BettiClassifier(BaseEstimator):
 
     def pooled_betti(self, windows: Sequence[Diagram]) -> dict[int, int]:
         """A region's beta_hat_n over its windows' diagrams: the lower median of their counts."""
-        from .ratio import median_vote
-
         counts = [self.betti(d) for d in windows]
         return {n: median_vote([c[n] for c in counts]) for n in counts[0]}
 
     def region_confidence(self, windows: Sequence[Diagram], voted=None) -> dict[int, float | None]:
         """Confidence of a region mapped in windows: that of its representative window
-        (``voted``: :func:`swarmtopo.readers.ratio.vote`'s result, when the caller has it)."""
-        from .ratio import vote
-
+        (``voted``: :func:`swarmtopo.readers.base.vote`'s result, when the caller has it)."""
         _, rep, _ = voted or vote(self, windows)
         return self.confidence(windows[rep])
+
+    def map_confidence(self, confidences: Sequence[float | None], n: int = 1) -> float | None:
+        """P(a map's beta_n is right): the product of its regions' P(right); None if one has none."""
+        return product_confidence(confidences)
 
     def confidence(self, diagram: Diagram) -> dict[int, float | None]:
         """P(beta_hat_n is right) from the calibrated (margin, gap) model; None if uncalibrated."""
@@ -330,18 +328,14 @@ class BettiClassifier(BaseEstimator):
                 raise InputError(f"Theta_{n} out of range (need 0 <= q <= 1, Delta >= 0, tau > 0)",
                                  file=source, column=f"theta.{n}", value=th.to_json())
         if obj.get("calibration"):
-            model.calibration_ = _checked_calibration(obj["calibration"], source)
+            model.calibration_ = _checked_calibration(obj["calibration"], model.theta_, source)
         return model
 
     def save(self, path) -> None:
-        from ..io.logs import write_json
-
         write_json(self.to_json(), path)
 
     @classmethod
     def load(cls, path) -> "BettiClassifier":
-        from ..io.logs import read_json
-
         return cls.from_json(read_json(path), source=str(path))
 
     @classmethod
@@ -406,68 +400,33 @@ def detection_scores(estimated, truth) -> DetectionScores:
     )
 
 
-# -- shipped classifiers ---------------------------------------------------------------
-def _checked_calibration(calibration, source: str) -> dict:
-    """A file's calibration (:func:`file_calibration`); each dimension's model must hold
-    the numbers it is applied with, and "maps" must be a count."""
-    out = file_calibration(calibration, source)
-    for n, model in out.items():
+# -- files and the published Theta* ---------------------------------------------------
+def _checked_calibration(calibration, theta: dict[int, Theta], source: str) -> dict:
+    """A file's calibration: "maps", a count, and for each dimension of ``theta`` a model
+    of the finite numbers it is applied with (CALIBRATION_KEYS)."""
+    if not isinstance(calibration, dict):
+        raise InputError("must be an object of {dimension: model}", file=source, column="calibration",
+                         value=calibration)
+    dims = {str(n) for n in theta}
+    for n, model in calibration.items():
         if n == "maps":
             ok = isinstance(model, int) and not isinstance(model, bool) and model >= 0
         else:
-            ok = isinstance(model, dict) and all(
+            ok = n in dims and isinstance(model, dict) and all(
                 isinstance(model.get(key), (int, float)) and not isinstance(model.get(key), bool)
                 and np.isfinite(model[key]) for key in CALIBRATION_KEYS)
         if not ok:
-            raise InputError("a calibration maps 'maps' to a count and each dimension to finite numbers "
+            raise InputError("a calibration maps 'maps' to a count and each dimension of theta to finite numbers "
                              f"{', '.join(map(repr, CALIBRATION_KEYS))}", file=source, column=f"calibration.{n}",
                              value=model)
-    return out
+    return dict(calibration)
 
 
-def load_classifier(name: str | Path):
-    """A shipped classifier by name or a JSON file.
-
-    Presets (``PRESETS``): "default", the :class:`~swarmtopo.readers.ratio.RatioClassifier`
-    tuned on the accuracy benchmark by ``lab/tune_accuracy.py``; "trace", the same
-    tuned on the benchmark's logs read as contact traces (encounters only), which
-    ``map`` uses for logs without status changes; "gated", the default with a gate of
-    cross-window cycle agreement, fitted by ``lab/fit_agreement_gate.py`` (measured,
-    not better: docs/accuracy.md); "paper-form", the
-    paper's classifier form trained our way by ``lab/train_classifier.py``;
-    "paper", the paper's published Theta*.  A file may hold either form (its
-    ``format`` key says which).
-    """
-    from ..io.logs import read_json
-    from .ratio import READ_FORMATS, RatioClassifier
-
-    if str(name) in PRESETS:
-        source = f"swarmtopo/data/classifier-{name}.json"
-        obj = json.loads(_preset_text(str(name)))
-    else:
-        path = Path(name)
-        if not path.exists():
-            raise InputError(f"no such classifier: expected one of {', '.join(PRESETS)} or a JSON file",
-                             file=str(path), value=str(name))
-        source, obj = str(path), read_json(path)
-    check_format(obj, (CLASSIFIER_FORMAT, *READ_FORMATS), "swarmtopo classifier", source)
-    if obj["format"] in READ_FORMATS:
-        return RatioClassifier.from_json(obj, source=source)
-    return BettiClassifier.from_json(obj, source=source)
-
-
-@lru_cache(maxsize=None)
-def _preset_text(name: str) -> str:
-    """A shipped classifier's JSON, read once per process (every map without an explicit
-    classifier loads the default: a fresh estimator from the cached text)."""
-    return resources.files("swarmtopo.data").joinpath(f"classifier-{name}.json").read_text("utf-8")
-
-
-def paper_classifier() -> BettiClassifier:
-    """The paper's published Theta*_1 = (0.5, 0.7, 3.7), uncalibrated."""
+def published_paper_classifier() -> BettiClassifier:
+    """The paper's published Theta*_1 = (0.5, 0.7, 3.7) (PAPER_THETA), uncalibrated."""
     return BettiClassifier.from_theta(PAPER_THETA, {
-        "name": "paper", "source": "paper, section 'Robust Classification of Persistence Intervals': "
-                                   "Theta*_1 = (0.5, 0.7, 3.7), F = 0.03 on 100 two-hole environments"})
+        "name": "paper-theta", "source": "paper, section 'Robust Classification of Persistence Intervals': "
+                                         "Theta*_1 = (0.5, 0.7, 3.7), F = 0.03 on 100 two-hole environments"})
 
 
 # -- optimizers ------------------------------------------------------------------------
@@ -603,3 +562,14 @@ def _truth_matrix(y, m: int, dims: list[int]) -> np.ndarray:
     if (truth < 0).any():
         raise SwarmtopoError("true Betti numbers must be >= 0")
     return truth
+
+
+# Transitional re-export for callers that import load_classifier from this module (cli.py,
+# lab scripts, tests): the registry imports this module, so it is imported last and looked
+# up when called.
+from . import registry as _registry  # noqa: E402
+
+
+def load_classifier(name):
+    """:func:`swarmtopo.readers.registry.load_classifier` (its transitional name here)."""
+    return _registry.load_classifier(name)

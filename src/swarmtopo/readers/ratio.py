@@ -17,26 +17,26 @@ Delta = 0, bars longer than tau_n l_q.
 A region's log is cut into time windows of several lengths (``MapConfig.window_length``,
 ``window_scales``), each mapped on its own.  Its beta_hat_n *pools* them (``pooling``):
 
-``"mean"`` (format /3, the default)
+``"mean"`` (the default)
     the mean score of each rank over the W windows, S_k = (1/W) sum_w s^w_(k), and
     beta_hat_n = #{k : S_k > ln tau_n}.  S is non-increasing (a mean of non-increasing
     sequences), so the counted ranks are the first ones.  The lower median of the
     windows' counts (below) throws away how far each window's bars are from the
     threshold and, with two windows, is their minimum; on the benchmark's tuning cases
     the mean scored higher (docs/accuracy.md).
-``"median"`` (format /1 and /2 files)
+``"median"``
     the lower median of the windows' own counts.
 
-Either way the counted bars of a window drawn for the user are its beta_hat_n longest.
+Either way the counted bars of a window drawn for the user are its beta_hat_n longest
+(:class:`~swarmtopo.readers.base.WindowReader`).
 
-Agreement gate (format /4; mean pooling, dimension 1).  With ``agreement`` b set, a rank
-k <= ``agreement.BARS`` whose pooled score passes (S_k > ln tau_1) is *vetoed* when its
-cross-window cycle agreement A_k (:mod:`swarmtopo.readers.agreement`: is the k-th loop the same
-loop in overlapping windows?) is at most b; a region without A_k (no two of its
-windows overlap) vetoes nothing.  A vetoed rank is dropped from every window's score sequence
-(:meth:`RatioClassifier.with_agreement`), so beta_hat_1 = #{k : S_k > ln tau_1 and not
-vetoed}, and the windows' own counts, the representative window, the drawn bars and z
-below are those of the sequences without it.
+Fitting (:meth:`RatioClassifier.fit`).  (q_1, tau_1) is chosen on maps with known
+beta_1 over the grid ``q_grid`` x ``tau_grid``: each map's beta_hat_1 (the sum over its
+regions) at every grid point, the exact rate of each point (a map whose beta_0 is wrong
+is wrong at every point), and the point whose mean rate over itself and its two tau
+neighbours (edges repeated) is highest (ties: the first), so that the choice sits inside
+a plateau rather than on a lucky spike.  Neighbours in q are not averaged: l_q grows
+with q, so the same tau means a different length threshold in the next q row.
 
 Confidence.  For each region the first feature is the vote's *standardised margin* z:
 how many standard errors the pooled scores are from changing the vote beta,
@@ -55,44 +55,38 @@ P(correct) is a logistic regression of z, ln L and z ln L (so that the windows'
 agreement weighs more the more places they resolve), fitted on the benchmark's tuning
 maps and on a calibration grid of swarms and logs beyond the suite's budgets
 (:meth:`RatioClassifier.calibrate`, ``lab/tune_accuracy.py``); files calibrated on z
-alone are applied so.  Files calibrated before z existed carry coefficients of the
-windows' *agreement* with the vote, the vote's log *margin* (capped at MAX_MARGIN) and
-the log number of *windows*; they are applied as they were fitted (:data:`REGION_FEATURES`).
+alone are applied so.
 
 A map of several regions (beta_0 >= 2) is right when every region is, and its
 confidence is the product of its regions' raised to a power a, ``regions_exponent`` of
-the calibration (:func:`map_confidence`; 1, the plain product, where a file has none).
-The regional model is fitted on one-region maps, whose landmarks cover a whole arena; a
-region of a two-room arena has fewer (ln L lower) and its confidence is lower than how
-often it is right.  a is fitted by maximum likelihood on the benchmark's two-room tuning
-maps (``lab/tune_accuracy.py``; docs/accuracy.md, "Confidence").
-
-Earlier files (/1, /2) could also gate bars by death/birth ratio, length in covering
-radii and a largest-gap rule; measured over three tuning rounds they never raised the
-rate and the shipped classifiers had them off.  Such files are read when the gates are
-off (as median pooling) and refused otherwise.
+the calibration (:meth:`RatioClassifier.map_confidence`; 1, the plain product, where a
+file has none).  The regional model is fitted on one-region maps, whose landmarks cover
+a whole arena; a region of a two-room arena has fewer (ln L lower) and its confidence
+is lower than how often it is right.  a is fitted by maximum likelihood on the
+benchmark's two-room tuning maps (``lab/tune_accuracy.py``; docs/accuracy.md, "Confidence").
 """
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass
 from typing import Any, Sequence
 
 import numpy as np
+from scipy.ndimage import uniform_filter1d
 from scipy.special import expit
+from sklearn.base import BaseEstimator
 from sklearn.linear_model import LogisticRegression
 
 from .. import __version__
-from .._validate import check_format, file_calibration
-from .agreement import BARS, agreement_array
+from .._json import read_json, write_json
+from .._validate import check_format
 from ..errors import InputError, SwarmtopoError
 from ..topology.persistence import Diagram
+from .base import longest_bars  # noqa: F401 (re-exported)
+from .base import WindowReader, median_vote, product_confidence, vote
 
-RATIO_FORMAT = "swarmtopo-ratio-classifier/4"
-READ_FORMATS = ("swarmtopo-ratio-classifier/1", "swarmtopo-ratio-classifier/2", "swarmtopo-ratio-classifier/3",
-                RATIO_FORMAT)
-"""Readable formats: /1 and /2 files pool by the median of the windows' counts; only /4 files gate by agreement."""
+RATIO_FORMAT = "swarmtopo-ratio-classifier/5"
+"""The one file format read and written (/5: no agreement gate, calibrations of z)."""
 POOLINGS = ("mean", "median")
 MAX_MARGIN = 3.0
 """Cap of the log margin (a score e^3 = 20 times off the threshold is as sure as it gets)."""
@@ -105,35 +99,31 @@ RESOLUTION_CAP = 400
 (``MapConfig.max_landmarks``) in every map the confidence was calibrated on, so a larger
 ``--max-landmarks`` does not read as a resolution never calibrated."""
 CONFIDENCE_FEATURES = ("z", "resolution", "z_x_resolution")
-"""The features :meth:`RatioClassifier.calibrate` fits."""
+"""The features :meth:`RatioClassifier.calibrate` fits: all three, or z alone."""
 SPAN_FEATURES = ("log_span", "z_x_log_span")
 """ln T and z ln T, T the seconds a region's windows cover (:func:`windows_span`): candidate
-features ``lab/calibration.py`` measures (not adopted, docs/accuracy.md); no
-calibration file weighs them."""
-OLD_FEATURES = ("agreement", "margin", "windows")
-"""The features of files calibrated before z existed."""
-REGION_FEATURES = (*CONFIDENCE_FEATURES, *OLD_FEATURES)
-"""Every feature :meth:`RatioClassifier.region_features` gives: a calibration weighs z, the
-resolution and their product, z alone, or (files calibrated before z) the other three."""
+features ``lab/calibration.py`` measures (not adopted, docs/accuracy.md), as is ln #windows
+("windows"); no calibration weighs them."""
 REGIONS_EXPONENT = "regions_exponent"
 """The calibration key of a, the power of the product of a several-region map's regional
-confidences (:func:`map_confidence`)."""
+confidences (:meth:`RatioClassifier.map_confidence`)."""
 
 LOG_RATIO_CAP = float(np.log(1e3))
 """Cap of a bar's score: a bar 1000 times the typical noise loop (or infinite) is as long as it gets."""
+Q_GRID = (0.5, 0.6, 0.7, 0.8, 0.9)
+TAU_GRID = tuple(np.round(np.geomspace(1.2, 12.0, 80), 4))
+"""The (q_1, tau_1) grid :meth:`RatioClassifier.fit` searches by default."""
 
 
 @dataclass(frozen=True)
 class RatioThresholds:
-    """(q_n, tau_n) of one dimension: a bar counts in its window when l > tau_n l_q; and the
-    agreement gate b (None: no gate), which vetoes a passing rank with A_k <= b (module docstring)."""
+    """(q_n, tau_n) of one dimension: a bar counts in its window when l > tau_n l_q."""
 
     q: float
     tau: float
-    agreement: float | None = None
 
     def to_json(self) -> dict[str, float]:
-        return {"q": self.q, "tau": self.tau, **({} if self.agreement is None else {"agreement": self.agreement})}
+        return {"q": self.q, "tau": self.tau}
 
 
 def noise_length(diagram: Diagram, dim: int, q: float) -> float:
@@ -203,17 +193,11 @@ def calibrated_probability(model: dict[str, float], features: dict[str, float]) 
 
 
 def map_confidence(classifier, confidences: Sequence[float | None], n: int = 1) -> float | None:
-    """P(a map's beta_n is right) from its regions' P(right) ``confidences``: the one
-    region's, or for several the product raised to the calibration's ``regions_exponent``
-    a (1 where a :class:`RatioClassifier` has none, and for classifiers of other kinds);
-    None if a region has none."""
-    if not len(confidences) or any(p is None for p in confidences):
-        return None
-    product = float(np.prod(confidences))
-    if len(confidences) == 1 or not isinstance(classifier, RatioClassifier):
-        return product
-    model = classifier.calibration_.get(str(n)) or {}
-    return product ** float(model.get(REGIONS_EXPONENT, 1.0))
+    """P(a map's beta_n is right) from its regions' ``confidences``: ``classifier``'s
+    :meth:`RatioClassifier.map_confidence`, the plain product for classifiers of other kinds."""
+    if isinstance(classifier, RatioClassifier):
+        return classifier.map_confidence(confidences, n)
+    return product_confidence(confidences)
 
 
 def confidence_model() -> LogisticRegression:
@@ -228,11 +212,7 @@ def confidence_design(features: Sequence[dict[str, float]], names: Sequence[str]
 
 def score_matrix(diagrams: Sequence[Diagram], dim: int, q: float) -> np.ndarray:
     """(W, K) scores s^w_(k) of the W windows, a rank a window has no bar for scoring 0."""
-    return _padded([window_scores(d, dim, q) for d in diagrams])
-
-
-def _padded(ranked: Sequence[np.ndarray]) -> np.ndarray:
-    """The windows' decreasing score sequences as rows of one matrix, missing ranks 0."""
+    ranked = [window_scores(d, dim, q) for d in diagrams]
     out = np.zeros((len(ranked), max((len(s) for s in ranked), default=0)))
     for w, s in enumerate(ranked):
         out[w, :len(s)] = s
@@ -277,219 +257,186 @@ def score_margin(scores: np.ndarray, tau: float) -> float:
     return float(min([MAX_MARGIN, *sides]))
 
 
-def longest_bars(diagram: Diagram, dim: int, count: int, skip: Sequence[int] = ()) -> np.ndarray:
-    """Indices into ``diagram[dim]`` of its ``count`` longest bars (infinite first; ties by position),
-    the bars of the 0-based length ranks in ``skip`` (vetoed ranks) left out."""
-    if dim > diagram.maxdim or count <= 0:
-        return np.empty(0, np.int64)
-    return np.delete(np.argsort(-diagram.lengths(dim), kind="stable"),
-                     [k for k in skip if k < len(diagram[dim])])[:count]
-
-
-def median_vote(counts: Sequence[int]) -> int:
-    """The lower median of the windows' counts."""
-    ordered = sorted(int(c) for c in counts)
-    return ordered[(len(ordered) - 1) // 2]
-
-
-def vote(classifier, windows: Sequence[Diagram], events: Sequence[int] | None = None
-         ) -> tuple[dict[int, int], int, dict[int, list[int]]]:
-    """A region's beta_hat from its windows' diagrams: (vote, representative window, counts per window).
-
-    ``classifier`` is a :class:`RatioClassifier` (pooled as its ``pooling`` says) or the
-    paper-form :class:`~swarmtopo.readers.paper.BettiClassifier` (the lower median of the
-    windows' counts): its ``pooled_betti``.  The representative window is, among those
-    whose own count equals the vote in the lowest dimension (or, if none does, is
-    nearest it) and that hold at least half the ``events`` of the fullest of them (all
-    of them without ``events``: a near-empty window of a bursty trace is no picture of
-    the region), the one whose nearest bar is farthest from the threshold (the first on
-    ties).
-    """
-    if not windows:
-        raise SwarmtopoError("no window of this region has enough events to map")
-    per_window = [classifier.betti(d) for d in windows]  # a classifier with_agreement: without its vetoed ranks
-    counts = {n: [c[n] for c in per_window] for n in per_window[0]}
-    betti = classifier.pooled_betti(windows)
-    if not counts:
-        return betti, 0, counts
-    key = min(counts)
-    off = [abs(c - betti[key]) for c in counts[key]]
-    nearest = [i for i, x in enumerate(off) if x == min(off)]
-    if events is not None:
-        fullest = max(events[i] for i in nearest)
-        nearest = [i for i in nearest if 2 * events[i] >= fullest]
-    margins = [classifier.margin(windows[i], key) for i in nearest]
-    return betti, nearest[int(np.argmax(margins))], counts
-
-
 def region_reader(classifier, windows: Sequence[Diagram], agreement) -> Any:
-    """How ``classifier`` reads one region: :meth:`RatioClassifier.with_agreement` if it gates
-    by agreement, else itself.  ``agreement``: the region's A_k (array, or a JSON list with
-    null for NaN), None if not computed."""
-    if not (isinstance(classifier, RatioClassifier) and classifier.gated):
-        return classifier
-    return classifier.with_agreement(windows, None if agreement is None else agreement_array(agreement))
+    """How ``classifier`` reads one region: itself (``windows`` and ``agreement`` are not
+    read; kept for callers that pass them)."""
+    return classifier
 
 
-class RatioClassifier:
+def grid_estimates(maps: Sequence[Sequence[Sequence[Diagram]]], pooling: str = "mean",
+                   q_grid: Sequence[float] = Q_GRID, tau_grid: Sequence[float] = TAU_GRID) -> np.ndarray:
+    """beta_hat_1 of every map at every grid point, ``(len(maps), len(q_grid), len(tau_grid))``:
+    the pooled count (:meth:`RatioClassifier.pooled_betti`) summed over each map's regions,
+    at once for every tau.  ``maps[k]`` is map k's regions, each its windows' diagrams."""
+    log_tau = np.log(np.asarray(tau_grid, dtype=float))
+
+    def counts_over_tau(scores: np.ndarray) -> np.ndarray:  # #{k : scores_k > ln tau} for every tau
+        return len(scores) - np.searchsorted(np.sort(scores), log_tau, side="right")
+
+    est = np.zeros((len(maps), len(q_grid), len(log_tau)), np.int64)
+    for k, regions in enumerate(maps):
+        for region in regions:
+            for i, q in enumerate(q_grid):
+                if pooling == "mean":
+                    est[k, i] += counts_over_tau(pooled_scores(region, 1, q))
+                else:
+                    counts = np.sort([counts_over_tau(window_scores(d, 1, q)) for d in region], axis=0)
+                    est[k, i] += counts[(len(region) - 1) // 2]
+    return est
+
+
+class RatioClassifier(WindowReader, BaseEstimator):
     """beta_hat_n from bar lengths over their window's noise scale, pooled over windows.
+
+    scikit-learn conventions: ``__init__`` only stores, :meth:`fit` returns self,
+    learned attributes end in ``_``.  A classifier of given thresholds (a file, a
+    study's candidate) is made by :meth:`from_thresholds`.
 
     Parameters
     ----------
-    thresholds
-        ``{n: RatioThresholds(q_n, tau_n)}`` for each homology dimension n >= 1.
-    calibration
-        Per dimension the logistic P(correct): ``{"intercept", "z", "resolution",
-        "z_x_resolution"}``, ``{"intercept", "z"}`` or (older files) ``{"intercept",
-        "agreement", "margin", "windows"}`` (:meth:`region_features`), any of them with
-        ``"regions_exponent"`` (:func:`map_confidence`); None = uncalibrated.
-        (beta_0's confidence is the pipeline's: :mod:`swarmtopo.readers.beta0`.)
-    provenance
-        Free-form record of how it was fitted (name, data, script).
     pooling
         ``"mean"`` (pooled scores) or ``"median"`` (lower median of the windows' counts).
+    q_grid, tau_grid
+        The grid :meth:`fit` searches (q in [0, 1]; tau in [1, 1000), increasing).
 
     Attributes
     ----------
-    vetoed_
-        ``{n: 0-based ranks}`` dropped from every window's scores; empty except on the
-        region view :meth:`with_agreement` returns.
+    thresholds_ : dict[int, RatioThresholds]
+        ``{n: (q_n, tau_n)}`` for each homology dimension n >= 1.
+    calibration_ : dict
+        Per dimension the logistic P(correct): ``{"intercept", "z", "resolution",
+        "z_x_resolution"}`` or ``{"intercept", "z"}`` (:meth:`region_features`), either
+        with ``"regions_exponent"`` (:meth:`map_confidence`); empty = uncalibrated.
+        (beta_0's confidence is the pipeline's: :mod:`swarmtopo.readers.beta0`.)
+    provenance_ : dict
+        Free-form record of how it was fitted (name, data, script, ``pipeline``).
+    accuracy_ : float
+        The exact rate of the fitted grid point on the training maps (:meth:`fit` only).
+    surface_ : np.ndarray
+        ``(len(q_grid), len(tau_grid))`` exact rates on the training maps (:meth:`fit` only).
     """
 
-    def __init__(self, thresholds: dict[int, RatioThresholds], calibration: dict | None = None,
-                 provenance: dict | None = None, pooling: str = "mean"):
-        for n, th in thresholds.items():
-            if not (int(n) >= 1 and 0.0 <= th.q <= 1.0 and 1.0 <= th.tau < np.exp(LOG_RATIO_CAP)):
-                raise InputError(f"ratio thresholds of dimension {n} out of range (need 0 <= q <= 1, "
-                                 "1 <= tau < 1000)",
-                                 column=f"thresholds.{n}", value=th.to_json())
-        if pooling not in POOLINGS:
-            raise InputError(f"unknown pooling; expected one of {', '.join(POOLINGS)}", column="pooling",
-                             value=pooling)
-        for n, th in thresholds.items():
-            if th.agreement is not None and (int(n) != 1 or pooling != "mean" or isinstance(th.agreement, bool) or
-                                             not isinstance(th.agreement, (int, float)) or
-                                             not 0.0 <= th.agreement < 1.0):
-                raise InputError("an agreement gate needs dimension 1, mean pooling and 0 <= agreement < 1",
-                                 column=f"thresholds.{n}.agreement", value=th.agreement)
-        for n, model in (calibration or {}).items():
-            unknown = (set(model) - {"intercept", "maps", REGIONS_EXPONENT, *REGION_FEATURES}
-                       if isinstance(model, dict) else ())
-            if unknown:
-                raise InputError(f"unknown confidence feature(s) {sorted(unknown)}; known: "
-                                 f"{', '.join(REGION_FEATURES)} (and {REGIONS_EXPONENT})", column=f"calibration.{n}",
-                                 value=model)
-            if isinstance(model, dict) and ("resolution" in model) != ("z_x_resolution" in model):
-                raise InputError("a calibration weighs 'resolution' and 'z_x_resolution' together, or neither",
-                                 column=f"calibration.{n}", value=model)
-            if not isinstance(model, dict) or "intercept" not in model or not (
-                    "z" in model or set(OLD_FEATURES) <= set(model)):
-                raise InputError(f"a calibration needs 'intercept' and 'z' (older files: 'intercept', "
-                                 f"{', '.join(map(repr, OLD_FEATURES))})", column=f"calibration.{n}", value=model)
-            for key, value in model.items():
-                if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or (
-                        key == "maps" and value < 0):
-                    raise InputError("must be a finite number", column=f"calibration.{n}.{key}", value=value)
-                if key == REGIONS_EXPONENT and value <= 0:
-                    raise InputError("must be positive", column=f"calibration.{n}.{key}", value=value)
-        self.thresholds_ = {int(n): th for n, th in sorted(thresholds.items())}
-        self.calibration_ = dict(calibration or {})
-        self.provenance_ = dict(provenance or {})
+    def __init__(self, pooling: str = "mean", q_grid: Sequence[float] = Q_GRID,
+                 tau_grid: Sequence[float] = TAU_GRID):
         self.pooling = pooling
-        self.vetoed_: dict[int, tuple[int, ...]] = {}
+        self.q_grid = q_grid
+        self.tau_grid = tau_grid
 
-    # -- the agreement gate ----------------------------------------------------------------
-    @property
-    def gated(self) -> bool:
-        """Whether some dimension's count is gated by cross-window cycle agreement."""
-        return any(th.agreement is not None for th in self.thresholds_.values())
+    # -- fitting -------------------------------------------------------------------------
+    def fit(self, X: Sequence[Sequence[Sequence[Diagram]]], y, beta0_right=None,
+            provenance: dict | None = None) -> "RatioClassifier":
+        """(q_1, tau_1) on the grid (module docstring, "Fitting").
 
-    def _candidates(self, windows: Sequence[Diagram]) -> np.ndarray:
-        """0-based ranks k < agreement.BARS of dimension 1 that pass the score test (S_k > ln tau_1)."""
-        th = self.thresholds_.get(1)
-        if th is None or th.agreement is None or windows[0].maxdim < 1:
-            return np.empty(0, np.int64)
-        scores = pooled_scores(windows, 1, th.q)[:BARS]
-        return np.flatnonzero(scores > np.log(th.tau))
-
-    def needs_agreement(self, windows: Sequence[Diagram]) -> bool:
-        """Whether the region's vote depends on its A_k: gated, and some rank k <= BARS passes."""
-        return len(self._candidates(windows)) > 0
-
-    def with_agreement(self, windows: Sequence[Diagram], agreement: np.ndarray | None) -> "RatioClassifier":
-        """This classifier for one region: its passing ranks with A_k <= b vetoed (module docstring).
-
-        ``agreement`` is the region's A_1 .. A_BARS (:func:`swarmtopo.readers.agreement.rank_agreement`;
-        NaN: no two windows overlap, nothing vetoed); None only if :meth:`needs_agreement` is False.
+        ``X[k]`` is map k's regions, each a sequence of its windows' diagrams; ``y[k]``
+        its true beta_1; ``beta0_right[k]`` whether its beta_0 was right (default: all),
+        a map whose beta_0 is wrong being wrong whatever the thresholds.
         """
-        candidates = self._candidates(windows)
-        view = copy.copy(self)
-        view.vetoed_ = {}
-        if len(candidates):
-            if agreement is None:
-                raise SwarmtopoError("this region's vote needs its cross-window cycle agreement, which was not "
-                                     "computed: map it with this classifier, or with agreement 'always'")
-            b = self.thresholds_[1].agreement
-            vetoed = tuple(int(k) for k in candidates if agreement[k] <= b)
-            view.vetoed_ = {1: vetoed} if vetoed else {}
-        return view
+        _check_pooling(self.pooling)
+        q_grid = [float(q) for q in self.q_grid]
+        tau_grid = np.asarray(self.tau_grid, dtype=float)
+        if not q_grid or any(not 0.0 <= q <= 1.0 for q in q_grid):
+            raise SwarmtopoError(f"q_grid must be values in [0, 1], got {list(self.q_grid)}")
+        if (tau_grid.ndim != 1 or not len(tau_grid) or np.any(np.diff(tau_grid) <= 0) or tau_grid[0] < 1.0
+                or tau_grid[-1] >= np.exp(LOG_RATIO_CAP)):
+            raise SwarmtopoError(f"tau_grid must be increasing values in [1, 1000), got {list(self.tau_grid)}")
+        truth = np.asarray(y, dtype=np.int64)
+        right_beta0 = np.ones(len(X), bool) if beta0_right is None else np.asarray(beta0_right, dtype=bool)
+        if not len(X) or truth.shape != (len(X),) or right_beta0.shape != (len(X),):
+            raise SwarmtopoError(f"fit needs one or more maps and one true beta_1 (and beta0_right) per map, got "
+                                 f"{len(X)} maps, y of shape {truth.shape}, beta0_right of shape {right_beta0.shape}")
+        if (truth < 0).any():
+            raise SwarmtopoError("true Betti numbers must be >= 0")
+        right = (grid_estimates(X, self.pooling, q_grid, tau_grid) == truth[:, None, None]) & right_beta0[:, None, None]
+        surface = right.mean(axis=0)
+        smooth = uniform_filter1d(surface, size=3, axis=1, mode="nearest")
+        i, j = np.unravel_index(int(np.argmax(smooth + 1e-9 * surface)), surface.shape)
+        self.thresholds_ = {1: RatioThresholds(q_grid[i], float(tau_grid[j]))}
+        self.calibration_ = {}
+        self.provenance_ = dict(provenance or {})
+        self.accuracy_ = float(surface[i, j])
+        self.surface_ = surface
+        return self
 
-    def scores(self, diagram: Diagram, n: int) -> np.ndarray:
-        """The window's decreasing dim-n scores (:func:`window_scores`) without the vetoed ranks."""
-        scores = window_scores(diagram, n, self.thresholds_[n].q)
-        return np.delete(scores, [k for k in self.vetoed_.get(n, ()) if k < len(scores)])
+    def calibrate(self, features: Sequence[dict[str, float]], correct,
+                  names: Sequence[str] = CONFIDENCE_FEATURES) -> "RatioClassifier":
+        """Fit P(correct | the ``names`` features: CONFIDENCE_FEATURES or z alone) for dimension 1.
 
-    def score_matrix(self, windows: Sequence[Diagram], n: int) -> np.ndarray:
-        """(W, K) scores of the windows (:func:`score_matrix`) without the vetoed ranks."""
-        return _padded([self.scores(d, n) for d in windows])
+        ``features[k]`` are region k's (:meth:`region_features`, of this or of another
+        classifier when the outcomes are cross-fitted) and ``correct[k]`` whether its
+        vote was right.
+        """
+        self._check_fitted()
+        if tuple(names) not in (CONFIDENCE_FEATURES, ("z",)):
+            raise SwarmtopoError(f"a calibration weighs {', '.join(CONFIDENCE_FEATURES)} or z alone, "
+                                 f"not {', '.join(names)}")
+        X = confidence_design(features, names)
+        y = np.asarray(correct, dtype=bool)
+        if len(np.unique(y)) == 2:
+            model = confidence_model().fit(X, y)
+            intercept, coefficients = float(model.intercept_[0]), model.coef_[0]
+        else:  # all right (or all wrong): the smoothed rate, whatever the features
+            rate = (y.sum() + 1) / (len(y) + 2)
+            intercept, coefficients = float(np.log(rate / (1 - rate))), np.zeros(len(names))
+        self.calibration_ = {"1": {"intercept": intercept, **dict(zip(names, map(float, coefficients))),
+                                   "maps": int(len(y))}}
+        self.provenance_.pop("regions_calibration", None)  # a new regional model: no power fitted on it yet
+        return self
 
-    def counted_bars(self, diagram: Diagram, n: int, count: int) -> np.ndarray:
-        """Indices into ``diagram[n]`` of the bars counted in a window: its ``count`` longest not vetoed."""
-        return longest_bars(diagram, n, count, self.vetoed_.get(n, ()))
+    @classmethod
+    def from_thresholds(cls, thresholds: dict[int, RatioThresholds], calibration: dict | None = None,
+                        provenance: dict | None = None, pooling: str = "mean") -> "RatioClassifier":
+        """A classifier of given thresholds (and calibration), not fitted here; checked."""
+        _check_pooling(pooling)
+        model = cls(pooling=pooling)
+        model.thresholds_ = _checked_thresholds(thresholds)
+        model.calibration_ = _checked_calibration(calibration or {}, model.thresholds_)
+        model.provenance_ = dict(provenance or {})
+        return model
+
+    def _check_fitted(self) -> None:
+        if not hasattr(self, "thresholds_"):
+            raise SwarmtopoError("this RatioClassifier is not fitted yet: call fit() or load one")
 
     # -- one window --------------------------------------------------------------------
     def betti(self, diagram: Diagram) -> dict[int, int]:
         """The window's own beta_hat_n, for n up to the diagram's maxdim."""
-        return {n: count_above(self.scores(diagram, n), th.tau)
+        self._check_fitted()
+        return {n: count_above(window_scores(diagram, n, th.q), th.tau)
                 for n, th in self.thresholds_.items() if n <= diagram.maxdim}
 
     def length_thresholds(self, diagram: Diagram) -> dict[int, float]:
         """tau_n l_q: the length a bar of this window must exceed to count in it, seconds."""
+        self._check_fitted()
         return {n: th.tau * noise_length(diagram, n, th.q)
                 for n, th in self.thresholds_.items() if n <= diagram.maxdim}
 
     def margin(self, diagram: Diagram, n: int) -> float:
         """How far the window's own count in dimension n is from changing (:func:`score_margin`)."""
-        return score_margin(self.scores(diagram, n), self.thresholds_[n].tau)
+        th = self.thresholds_[n]
+        return score_margin(window_scores(diagram, n, th.q), th.tau)
 
     # -- a region: several windows --------------------------------------------------------
     def pooled_betti(self, windows: Sequence[Diagram]) -> dict[int, int]:
         """The region's beta_hat_n: pooled scores (``"mean"``) or the lower median of the
         windows' counts (``"median"``)."""
+        self._check_fitted()
         maxdim = windows[0].maxdim
         if self.pooling == "median":
             return {n: median_vote([self.betti(d)[n] for d in windows]) for n in self.thresholds_ if n <= maxdim}
-        return {n: count_above(self.score_matrix(windows, n).mean(axis=0), th.tau)
+        return {n: count_above(score_matrix(windows, n, th.q).mean(axis=0), th.tau)
                 for n, th in self.thresholds_.items() if n <= maxdim}
 
     def region_features(self, windows: Sequence[Diagram], n: int, voted=None,
                         span: float | None = None) -> dict[str, float]:
         """One region's confidence features for dimension n: z, the resolution ln L and their
-        product (module docstring), and the agreement, capped log margin and ln #windows that
-        older calibrations use; given ``span`` (the seconds T its windows cover) also the
-        measured candidates ln T and z ln T (SPAN_FEATURES).
+        product (module docstring), and ln #windows; given ``span`` (the seconds T its
+        windows cover) also ln T and z ln T (SPAN_FEATURES).
         ``voted`` is :func:`vote`'s result for these windows when the caller has it."""
-        betti, rep, counts = voted or vote(self, windows)
+        betti = (voted or vote(self, windows))[0]
         th = self.thresholds_[n]
-        matrix = self.score_matrix(windows, n)
-        if self.pooling == "median":
-            margin = self.margin(windows[rep], n)
-        else:
-            margin = score_margin(matrix.mean(axis=0), th.tau)
-        z, ln_l = standardised_margin(matrix, betti[n], th.tau), resolution(windows)
-        features = {"z": z, "resolution": ln_l, "z_x_resolution": z * ln_l,
-                    "agreement": float(np.mean(np.asarray(counts[n]) == betti[n])),
-                    "margin": margin, "windows": float(np.log(len(windows)))}
+        z = standardised_margin(score_matrix(windows, n, th.q), betti[n], th.tau)
+        ln_l = resolution(windows)
+        features = {"z": z, "resolution": ln_l, "z_x_resolution": z * ln_l, "windows": float(np.log(len(windows)))}
         if span is not None:
             ln_t = float(np.log(span))
             features |= {"log_span": ln_t, "z_x_log_span": z * ln_t}
@@ -504,37 +451,20 @@ class RatioClassifier:
             if n > windows[0].maxdim:
                 continue
             model = self.calibration_.get(str(n))
-            if model is None:
-                out[n] = None
-                continue
-            out[n] = calibrated_probability(model, self.region_features(windows, n, voted))
+            out[n] = None if model is None else calibrated_probability(model, self.region_features(windows, n, voted))
         return out
 
-    # -- fitting -------------------------------------------------------------------------
-    def calibrate(self, features: Sequence[dict[str, float]], correct,
-                  names: Sequence[str] = CONFIDENCE_FEATURES) -> "RatioClassifier":
-        """Fit P(correct | the ``names`` features) for dimension 1.
-
-        ``features[k]`` are region k's (:meth:`region_features`, of this or of another
-        classifier when the outcomes are cross-fitted) and ``correct[k]`` whether its
-        vote was right.
-        """
-        X = confidence_design(features, names)
-        y = np.asarray(correct, dtype=bool)
-        if len(np.unique(y)) == 2:
-            model = confidence_model().fit(X, y)
-            intercept, coefficients = float(model.intercept_[0]), model.coef_[0]
-        else:  # all right (or all wrong): the smoothed rate, whatever the features
-            rate = (y.sum() + 1) / (len(y) + 2)
-            intercept, coefficients = float(np.log(rate / (1 - rate))), np.zeros(len(names))
-        self.calibration_ = {"1": {"intercept": intercept, **dict(zip(names, map(float, coefficients))),
-                                   "maps": int(len(y))}}
-        self.provenance_.pop("regions_calibration", None)  # a new regional model: no power fitted on it yet
-        return self
+    def map_confidence(self, confidences: Sequence[float | None], n: int = 1) -> float | None:
+        """P(a map's beta_n is right) from its regions' P(right): the one region's, or for
+        several their product raised to the calibration's ``regions_exponent`` a (1 where
+        it has none); None if a region has none (module docstring)."""
+        model = self.calibration_.get(str(n)) or {}
+        return product_confidence(confidences, model.get(REGIONS_EXPONENT, 1.0))
 
     # -- description and files ------------------------------------------------------------
     def describe(self) -> dict[str, Any]:
         """What map.json says about how its Betti numbers were read."""
+        self._check_fitted()
         pooled = ("the number of ranks k whose mean score over the time windows exceeds ln tau, a window's k-th "
                   "score being ln(l / l_q) of its k-th longest dim-n bar (clipped to [0, ln 1000]; l_q = q-quantile "
                   "of the window's dim-n bar lengths)" if self.pooling == "mean" else
@@ -546,9 +476,6 @@ class RatioClassifier:
             "pooling": self.pooling,
             "threshold": "tau_n l_q",
             "theta": {str(n): th.to_json() for n, th in self.thresholds_.items()},
-            **({"agreement_gate": "a rank whose mean score passes is not counted when its cross-window cycle "
-                "agreement A_k (the correlation of its loop's circular coordinates in overlapping windows, on the "
-                "events they share) is at most theta.1.agreement"} if self.gated else {}),
             "confidence": self._confidence_definition(),
         }
 
@@ -556,24 +483,21 @@ class RatioClassifier:
         model = self.calibration_.get("1")
         if model is None:
             return "uncalibrated"
-        return self._region_confidence_definition(model) + (
+        if "resolution" in model:
+            regional = ("P(correct) from a logistic model of z, how many standard errors (over the windows) the "
+                        "pooled scores are from changing the vote, of the windows' resolution ln L (L landmarks, at "
+                        f"most {RESOLUTION_CAP}) and of z ln L, fitted on the benchmark's tuning maps and its "
+                        "calibration grid")
+        else:
+            regional = ("P(correct) from a logistic model of z, how many standard errors (over the windows) the "
+                        "pooled scores are from changing the vote, fitted on the benchmark's tuning maps")
+        return regional + (
             f"; a map of several regions: the product of its regions' to the power {model[REGIONS_EXPONENT]:.3g}, "
             "fitted on the benchmark's two-room tuning maps" if REGIONS_EXPONENT in model else
             "; a map of several regions: the product of its regions'")
 
-    @staticmethod
-    def _region_confidence_definition(model: dict[str, float]) -> str:
-        if "resolution" in model:
-            return ("P(correct) from a logistic model of z, how many standard errors (over the windows) the pooled "
-                    "scores are from changing the vote, of the windows' resolution ln L (L landmarks, at most "
-                    f"{RESOLUTION_CAP}) and of z ln L, fitted on the benchmark's tuning maps and its calibration grid")
-        if "z" in model:
-            return ("P(correct) from a logistic model of z, how many standard errors (over the windows) the pooled "
-                    "scores are from changing the vote, fitted on the benchmark's tuning maps")
-        return ("P(correct) from a logistic model of the windows' agreement with the vote, the vote's log margin and "
-                "the number of windows, fitted on the benchmark's tuning maps")
-
     def to_json(self) -> dict[str, Any]:
+        self._check_fitted()
         return {
             "format": RATIO_FORMAT,
             "pooling": self.pooling,
@@ -583,31 +507,94 @@ class RatioClassifier:
         }
 
     def save(self, path) -> None:
-        from ..io.logs import write_json
-
         write_json(self.to_json(), path)
 
     @classmethod
+    def load(cls, path) -> "RatioClassifier":
+        return cls.from_json(read_json(path), source=str(path))
+
+    @classmethod
     def from_json(cls, obj: dict, source: str = "<json>") -> "RatioClassifier":
-        check_format(obj, READ_FORMATS, "swarmtopo ratio classifier", source)
+        """A classifier from a file's object: format RATIO_FORMAT only, every field checked."""
+        check_format(obj, RATIO_FORMAT, "swarmtopo ratio classifier", source)
         try:
-            thresholds = {}
-            for n, t in obj["thresholds"].items():
-                gates = {"rho": float(t.get("rho", 1.0)), "kappa": float(t.get("kappa", 0.0)),
-                         "gamma": float(t.get("gamma", 0.0))}
-                if gates != {"rho": 1.0, "kappa": 0.0, "gamma": 0.0}:
-                    raise InputError("this ratio classifier uses the death/birth, covering-radius or gap tests "
-                                     "of earlier swarmtopo versions, which are no longer applied; refit it "
-                                     "(lab/tune_accuracy.py)", file=source, column=f"thresholds.{n}",
-                                     value=gates)
-                gate = t.get("agreement") if obj["format"] == RATIO_FORMAT else None  # checked by __init__
-                thresholds[int(n)] = RatioThresholds(float(t["q"]), float(t["tau"]), gate)
-            pooling = obj.get("pooling", "mean") if obj["format"] in READ_FORMATS[2:] else "median"
-            calibration = file_calibration(obj.get("calibration"), source)
-            return cls(thresholds, calibration or None, obj.get("provenance") or {}, pooling)
+            thresholds = obj.get("thresholds")
+            if not isinstance(thresholds, dict) or not thresholds:
+                raise InputError("must be an object of {dimension: {q, tau}}", column="thresholds", value=thresholds)
+            parsed = {}
+            for n, t in thresholds.items():
+                if not isinstance(t, dict) or set(t) != {"q", "tau"}:
+                    raise InputError("must be an object of exactly 'q' and 'tau'", column=f"thresholds.{n}", value=t)
+                parsed[_dimension(n, f"thresholds.{n}")] = RatioThresholds(
+                    _real(t["q"], f"thresholds.{n}.q"), _real(t["tau"], f"thresholds.{n}.tau"))
+            provenance = obj.get("provenance") or {}
+            if not isinstance(provenance, dict):
+                raise InputError("must be an object", column="provenance", value=provenance)
+            return cls.from_thresholds(parsed, obj.get("calibration"), provenance, obj.get("pooling"))
         except InputError as exc:
             if exc.file is not None:
                 raise
             raise InputError(exc.reason, file=source, row=exc.row, column=exc.column, value=exc.value) from None
-        except (KeyError, TypeError, ValueError, AttributeError) as exc:
-            raise InputError(f"malformed ratio classifier: {exc!r}", file=source) from None
+
+
+def _check_pooling(pooling) -> None:
+    if pooling not in POOLINGS:
+        raise InputError(f"unknown pooling; expected one of {', '.join(POOLINGS)}", column="pooling", value=pooling)
+
+
+def _dimension(key, column: str) -> int:
+    """A homology dimension n >= 1 from a JSON key ("1") or an int."""
+    try:
+        n = int(key)
+    except (TypeError, ValueError):
+        n = 0
+    if n < 1 or str(n) != str(key):
+        raise InputError("must be a homology dimension n >= 1", column=column, value=key)
+    return n
+
+
+def _real(value, column: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+        raise InputError("must be a finite number", column=column, value=value)
+    return float(value)
+
+
+def _checked_thresholds(thresholds: dict[int, RatioThresholds]) -> dict[int, RatioThresholds]:
+    """``thresholds`` sorted by dimension; each dimension >= 1 with 0 <= q <= 1 and 1 <= tau < 1000."""
+    if not thresholds:
+        raise InputError("a ratio classifier needs thresholds of one dimension or more", column="thresholds", value={})
+    for n, th in thresholds.items():
+        if not (int(n) >= 1 and 0.0 <= th.q <= 1.0 and 1.0 <= th.tau < np.exp(LOG_RATIO_CAP)):
+            raise InputError(f"ratio thresholds of dimension {n} out of range (need 0 <= q <= 1, 1 <= tau < 1000)",
+                             column=f"thresholds.{n}", value=th.to_json())
+    return {int(n): th for n, th in sorted(thresholds.items())}
+
+
+def _checked_calibration(calibration, thresholds: dict[int, RatioThresholds]) -> dict:
+    """``calibration`` if each entry is a model of a dimension the classifier reads: an
+    intercept, z, optionally the resolution and z ln L together, optionally a positive
+    ``regions_exponent`` and a count of ``maps``, all finite numbers."""
+    if not isinstance(calibration, dict):
+        raise InputError("must be an object of {dimension: model}", column="calibration", value=calibration)
+    known = {"intercept", "maps", REGIONS_EXPONENT, *CONFIDENCE_FEATURES}
+    for n, model in calibration.items():
+        column = f"calibration.{n}"
+        if str(n) not in {str(d) for d in thresholds}:
+            raise InputError(f"a calibration of a dimension the classifier does not read (it reads "
+                             f"{', '.join(map(str, thresholds))})", column=column, value=model)
+        if not isinstance(model, dict) or "intercept" not in model or "z" not in model:
+            raise InputError("a calibration needs 'intercept' and 'z'", column=column, value=model)
+        unknown = set(model) - known
+        if unknown:
+            raise InputError(f"unknown confidence feature(s) {sorted(unknown)}; known: "
+                             f"{', '.join(CONFIDENCE_FEATURES)} (and {REGIONS_EXPONENT})", column=column, value=model)
+        if ("resolution" in model) != ("z_x_resolution" in model):
+            raise InputError("a calibration weighs 'resolution' and 'z_x_resolution' together, or neither",
+                             column=column, value=model)
+        for key, value in model.items():
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or (
+                    key == "maps" and value < 0):
+                raise InputError("must be a finite number", column=f"{column}.{key}", value=value)
+            if key == REGIONS_EXPONENT and value <= 0:
+                raise InputError("must be positive", column=f"{column}.{key}", value=value)
+    return {str(n): dict(model) for n, model in calibration.items()}

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -30,8 +31,8 @@ from .. import __version__
 from .._validate import fraction, non_negative, positive, positive_int
 from ..arena import Arena
 from ..errors import InputError
-from ..io.logs import LOG_FORMAT, jsonable
-from ..log import EncounterLog, state_labels
+from .._json import jsonable
+from ..log import LOG_FORMAT, EncounterLog, state_labels
 from . import commands as _commands
 from . import motion as _motion
 from . import sensing as _sensing
@@ -46,6 +47,9 @@ MAX_AGENT_STEPS = 1e10
 benchmark's largest run (800 agents x 120 s at dt = 0.1 s), hours of computing."""
 DT = 0.1
 """Default time step of :func:`simulate`, s."""
+DURATION_TOLERANCE = 1e-9
+"""Relative distance from a whole number of time steps within which a duration is
+that number of steps (30 s / 0.1 s = 299.99999999999994 steps is 300)."""
 
 
 @dataclass
@@ -98,7 +102,7 @@ def simulate(
     n_agents : int
         Swarm size N >= 1.
     duration : float
-        Simulated time, s (K = round(duration / dt) steps).
+        Simulated time, s: a whole number K >= 1 of time steps dt (to a relative 1e-9).
     dt : float
         Time step, s; must satisfy max(v_c, v_p) dt <= r_d / 4.
     motion, sensing : MotionParams, SensingParams
@@ -123,7 +127,7 @@ def simulate(
     Returns
     -------
     Simulation
-        ``log.meta`` holds ``format`` (:data:`swarmtopo.io.logs.LOG_FORMAT`), ``version``,
+        ``log.meta`` holds ``format`` (:data:`swarmtopo.log.LOG_FORMAT`), ``version``,
         ``units``, r_d, v_c, v_p, ``duration`` (t_K), dt, ``agent_count``, ``seed``
         and ``simulation`` (all parameters; infinities written as ``"inf"``).
 
@@ -221,8 +225,9 @@ def check_parameters(n_agents: int, duration: float, *, dt: float = DT,
     if not isinstance(sensing, SensingParams):
         raise InputError(f"sensing must be a SensingParams, got {type(sensing).__name__}")
     check_time_step(dt, motion, sensing)
-    non_negative("duration", duration)
+    positive("duration", duration)
     check_run_size(n_agents, duration, dt)
+    check_duration(duration, dt)
     non_negative("static_time", static_time)
     fraction("static_fraction", static_fraction)
     for c in commands:
@@ -257,6 +262,20 @@ def check_run_size(n_agents: int, duration: float, dt: float) -> None:
     if steps > MAX_AGENT_STEPS:
         raise InputError(f"{n_agents} agents x {duration:.3g} s / dt {dt:.3g} s = {steps:.3g} agent-steps, more than "
                          f"the {MAX_AGENT_STEPS:.0e} a run may take")
+
+
+def check_duration(duration: float, dt: float) -> None:
+    """InputError unless ``duration`` is a whole number K >= 1 of time steps ``dt``
+    (within a relative :data:`DURATION_TOLERANCE`): the last step is t_K = duration,
+    never a shorter run than asked for.  The message names the nearest valid durations."""
+    steps = duration / dt
+    whole = round(steps)
+    if whole >= 1 and abs(steps - whole) <= DURATION_TOLERANCE * steps:
+        return
+    nearest = [k * dt for k in (math.floor(steps), math.ceil(steps)) if k >= 1]
+    shown = " or ".join(f"{round(x, TIME_DECIMALS):.12g} s" for x in dict.fromkeys(nearest))
+    raise InputError(f"duration {duration:.12g} s is not a whole number of time steps dt = {dt:.12g} s "
+                     f"({steps:.6g} steps); use {shown}")
 
 
 def check_static_time(static_fraction: float, static_time: float, duration: float, dt: float) -> None:

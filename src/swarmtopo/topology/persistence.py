@@ -308,37 +308,37 @@ def _unrank(pairs: np.ndarray, values: np.ndarray) -> np.ndarray:
     return exact
 
 
-def _gudhi(matrix, maxdim, threshold, coefficients):
+def _gudhi(matrix, maxdim, threshold):
     from gudhi.sklearn.rips_persistence import RipsPersistence
 
     rips = RipsPersistence(
         homology_dimensions=list(range(maxdim + 1)),
         threshold=threshold,
         input_type="full distance matrix",
-        homology_coeff_field=coefficients,
+        homology_coeff_field=2,
     )
     return rips.fit_transform([matrix])[0], None
 
 
-def _ripser(matrix, maxdim, threshold, cocycles, coefficients):
+def _ripser(matrix, maxdim, threshold, cocycles):
     from ripser import ripser
 
     ranks, values, rank_threshold = _rank_transform(matrix, threshold)
-    out = ripser(ranks, maxdim=maxdim, thresh=rank_threshold, coeff=coefficients,
+    out = ripser(ranks, maxdim=maxdim, thresh=rank_threshold, coeff=2,
                  distance_matrix=True, do_cocycles=cocycles)
     return [_unrank(d, values) for d in out["dgms"]], out["cocycles"] if cocycles else None
 
 
-def _giotto(matrix, maxdim, threshold, coefficients):
+def _giotto(matrix, maxdim, threshold):
     from gph import ripser_parallel
 
     ranks, values, rank_threshold = _rank_transform(matrix, threshold)
-    out = ripser_parallel(ranks, maxdim=maxdim, thresh=rank_threshold, coeff=coefficients, metric="precomputed")
+    out = ripser_parallel(ranks, maxdim=maxdim, thresh=rank_threshold, coeff=2, metric="precomputed")
     return [_unrank(d, values) for d in out["dgms"]], None
 
 
 def rips_persistence(distances, maxdim: int = 1, *, backend: str = "auto",
-                     threshold: float = np.inf, cocycles: bool = False, coefficients: int = 2) -> PersistenceResult:
+                     threshold: float = np.inf, cocycles: bool = False) -> PersistenceResult:
     """Vietoris-Rips persistence diagrams dgm_0 .. dgm_maxdim of a distance matrix.
 
     Parameters
@@ -355,9 +355,6 @@ def rips_persistence(distances, maxdim: int = 1, *, backend: str = "auto",
         Largest filtration value eps; longer edges never enter the complex.
     cocycles
         Also return representative cocycles (ripser.py only).
-    coefficients
-        The prime p of the coefficient field Z/p (2 by default; circular coordinates
-        need an odd p, :mod:`swarmtopo.readers.agreement`).
 
     Returns
     -------
@@ -372,19 +369,16 @@ def rips_persistence(distances, maxdim: int = 1, *, backend: str = "auto",
     if not (isinstance(threshold, (int, float, np.number)) and threshold > 0):
         raise InputError("threshold must be a positive number (or inf)", value=threshold)
     threshold = float(threshold)
-    if isinstance(coefficients, bool) or not isinstance(coefficients, (int, np.integer)) or coefficients < 2 or any(
-            coefficients % d == 0 for d in range(2, int(np.sqrt(coefficients)) + 1)):
-        raise InputError("coefficients must be a prime", value=coefficients)
     name = _choose_backend(backend, cocycles)
     importlib.import_module(_BACKEND_ENTRY_MODULES[name])  # keep import time out of `seconds`
 
     start = time.perf_counter()
     if name == "gudhi":
-        raw, raw_cocycles = _gudhi(matrix, maxdim, threshold, int(coefficients))
+        raw, raw_cocycles = _gudhi(matrix, maxdim, threshold)
     elif name == "ripser":
-        raw, raw_cocycles = _ripser(matrix, maxdim, threshold, cocycles, int(coefficients))
+        raw, raw_cocycles = _ripser(matrix, maxdim, threshold, cocycles)
     else:
-        raw, raw_cocycles = _giotto(matrix, maxdim, threshold, int(coefficients))
+        raw, raw_cocycles = _giotto(matrix, maxdim, threshold)
     seconds = time.perf_counter() - start
 
     pairs, kept_cocycles = [], [] if cocycles else None

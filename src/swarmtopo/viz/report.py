@@ -10,10 +10,15 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.logs import make_folder, write_json
+from .._json import write_json
+from ..io.logs import make_folder
 from ..log import EncounterLog
-from ..pipeline.map import TopologicalMap
+from ..pipeline.result import TopologicalMap
+from .summary import map_json
 from .report_html import write_report
+
+MAP_FILES = ("map.json", "report.html", "diagram.png", "cloud.png")
+"""Every file :func:`write_map_outputs` may write: a map's output folder holds these."""
 
 
 def write_map_outputs(tmap: TopologicalMap, out_dir: Path, *, log: EncounterLog,
@@ -26,7 +31,7 @@ def write_map_outputs(tmap: TopologicalMap, out_dir: Path, *, log: EncounterLog,
     out_dir = Path(out_dir)
     make_folder(out_dir)
     written = [out_dir / "map.json", out_dir / "report.html", out_dir / "diagram.png"]
-    doc = tmap.to_json()  # one document for map.json and the report: they cannot disagree
+    doc = map_json(tmap)  # one document for map.json and the report: they cannot disagree
     write_json(doc, written[0])
     write_report(tmap, written[1], log=log, truth=truth, arena=arena, trajectories=trajectories, doc=doc)
     _diagram_figure(tmap).savefig(written[2], dpi=110)

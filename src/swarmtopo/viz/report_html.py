@@ -8,7 +8,7 @@ the 3-D MDS encounter point cloud (coloured by event time and, with ground truth
 true position), the cycles at true positions on the arena (ground truth), an
 animation of the swarm (simulations with trajectories), then parameters and timings.
 
-Every number shown comes from ``tmap.to_json()`` -- the map.json document -- so the
+Every number shown comes from ``viz.summary.map_json(tmap)`` -- the map.json document -- so the
 report and map.json cannot disagree.
 
 Untrusted input.  Agent IDs and ``meta.json`` come from whoever wrote the log.  In
@@ -29,8 +29,10 @@ import numpy as np
 
 from ..topology.cycles import encircled_obstacles, event_positions
 from ..log import STATES, EncounterLog
-from ..pipeline.map import TopologicalMap
+from ..pipeline.result import TopologicalMap
+from .summary import map_json
 from .plots import position_colors
+from .text import format_confidence
 
 MAX_ANIMATION_AGENTS = 120
 """Agents drawn in the swarm animation (evenly spaced among the sampled agents)."""
@@ -75,7 +77,7 @@ def report_html(tmap: TopologicalMap, *, log: EncounterLog, truth: dict | None =
     Parameters
     ----------
     tmap
-        The map; its numbers are taken from ``tmap.to_json()``.
+        The map; its numbers are taken from ``viz.summary.map_json(tmap)``.
     log
         The mapped log (event times and agent IDs for hover text, ``meta``).
     truth
@@ -86,11 +88,11 @@ def report_html(tmap: TopologicalMap, *, log: EncounterLog, truth: dict | None =
     trajectories
         Sampled true positions (``io.read_trajectories``): the swarm animation.
     doc
-        ``tmap.to_json()`` when the caller already has it (the map.json it writes).
+        ``viz.summary.map_json(tmap)`` when the caller already has it (the map.json it writes).
     """
     from plotly.offline import get_plotlyjs
 
-    doc = doc or tmap.to_json()
+    doc = doc or map_json(tmap)
     figures: dict[str, dict] = {}
     sections = [
         _verdict_section(doc, arena),
@@ -158,7 +160,8 @@ def _verdict_section(doc: dict, arena) -> str:
         n = int(key)
         conf = doc["confidence"].get(key)
         conf_html = ("no calibrated confidence" if conf is None else
-                     f'<span class="confidence" data-dim="{n}" data-value="{conf!r}">{percent(conf)}</span> confidence')
+                     f'<span class="confidence" data-dim="{n}" data-value="{conf!r}">{format_confidence(conf)}</span>'
+                     " confidence")
         shown = "unknown" if value is None else str(value)
         items.append(f'<span class="betti" data-dim="{n}" data-value="{shown}">&beta;<sub>{n}</sub> = {shown}</span>'
                      f" ({conf_html})")
@@ -170,7 +173,8 @@ def _verdict_section(doc: dict, arena) -> str:
         verdict = '<span class="ok">the map is right</span>' if agree else '<span class="bad">the map is wrong</span>'
         lines.append(f'<p class="truth">true (from the arena): {truth_items} &mdash; {verdict}</p>')
     holes = ("loops of the contact graph (groups linked in a cycle with no shortcut across it: not physical holes; "
-             "docs/real-data.md)" if doc["log"].get("contact_trace") else "holes (obstacles)")
+             "see the project's documentation, docs/real-data.md in the source repository)"
+             if doc["log"].get("contact_trace") else "holes (obstacles)")
     lines.append(f'<p class="note">&beta;<sub>0</sub> counts connected regions, &beta;<sub>1</sub> {holes}; '
                  "a confidence is the calibrated probability that the number is right.</p>")
     for warning in doc["warnings"]:
@@ -187,7 +191,7 @@ def _regions_table(doc: dict) -> str:
     rows = []
     for r in doc["regions"]:
         betti = ", ".join(f"&beta;<sub>{k}</sub> = {v}" for k, v in r["betti"].items())
-        conf = ", ".join("&ndash;" if v is None else percent(v) for v in r["confidence"].values())
+        conf = ", ".join("&ndash;" if v is None else format_confidence(v) for v in r["confidence"].values())
         rows.append(f'<tr><td>{r["component"]}</td><td class="num">{r["events"]}</td><td class="num">{r["agents"]}'
                     f'</td><td class="num">{r["landmarks"]}</td><td>{betti}</td><td>{conf}</td></tr>')
     return ("<table><tr><th>region</th><th>events</th><th>agents</th><th>landmarks</th><th>Betti numbers</th>"
@@ -274,9 +278,12 @@ def _arena_section(tmap: TopologicalMap, truth: dict, arena, figures: dict) -> s
 
 
 def _animation_section(trajectories: dict, arena, figures: dict) -> str:
-    figures["plot-animation"], n_agents, n_frames = _animation_figure(trajectories, arena)
+    figures["plot-animation"], (agents, swarm), (frames, samples) = _animation_figure(trajectories, arena)
+    shown = [f"{agents} agents" if agents == swarm else f"{agents} of the {swarm} agents",
+             f"{frames} sampled times" if frames == samples else f"{frames} of the {samples} sampled times"]
+    spacing = " (evenly spaced)" if (agents, frames) != (swarm, samples) else ""
     return ('<section id="animation"><h2>The swarm (simulation)</h2>\n'
-            f'<p class="note">{n_agents} agents over {n_frames} sampled times, coloured by state '
+            f'<p class="note">{shown[0]} at {shown[1]}{spacing}, coloured by state '
             "(random walk, wall following, stopped). Press play.</p>"
             '<div id="plot-animation" class="plot" style="height:620px"></div></section>\n')
 
@@ -299,11 +306,6 @@ def _parameters_section(doc: dict, log: EncounterLog) -> str:
             f'<tr><th>total</th><th class="num">{total:.3f} s</th></tr></table>'
             f"<h3>Classifier</h3><table>{classifier}</table>"
             f"<h3>Software</h3><table>{software}</table>{meta_table}</section>\n")
-
-
-def percent(p: float) -> str:
-    """A probability as the report shows it: ``0.3618`` -> ``"36.2%"``."""
-    return f"{100 * p:.1f}%"
 
 
 def _value(v) -> str:
@@ -519,15 +521,15 @@ def _evenly(n: int, k: int) -> np.ndarray:
     return np.arange(n) if n <= k else np.unique(np.round(np.linspace(0, n - 1, k)).astype(np.int64))
 
 
-def _animation_figure(trajectories: dict, arena) -> tuple[dict, int, int]:
+def _animation_figure(trajectories: dict, arena) -> tuple[dict, tuple[int, int], tuple[int, int]]:
     """A plotly animation of sampled trajectories: at most MAX_ANIMATION_AGENTS agents
-    at MAX_ANIMATION_FRAMES times.  Agents absent at a time are left out of that frame."""
+    at MAX_ANIMATION_FRAMES times.  Agents absent at a time are left out of that frame.
+    Returns the figure, (agents shown, agents sampled) and (times shown, times sampled)."""
     t = np.asarray(trajectories["t"], dtype=float)
     agent = np.asarray(trajectories["agent"])
-    times = np.unique(t)
-    times = times[_evenly(len(times), MAX_ANIMATION_FRAMES)]
-    agents = np.unique(agent)
-    agents = agents[_evenly(len(agents), MAX_ANIMATION_AGENTS)]
+    all_times, all_agents = np.unique(t), np.unique(agent)
+    times = all_times[_evenly(len(all_times), MAX_ANIMATION_FRAMES)]
+    agents = all_agents[_evenly(len(all_agents), MAX_ANIMATION_AGENTS)]
     keep = np.isin(t, times) & np.isin(agent, agents)
     row = np.searchsorted(times, t[keep])
     col = np.searchsorted(agents, agent[keep])
@@ -571,4 +573,4 @@ def _animation_figure(trajectories: dict, arena) -> tuple[dict, int, int]:
     layout["legend"] = {"orientation": "h", "x": 1, "xanchor": "right", "y": 1.08}
     figure = {"data": data, "layout": layout, "frames": frames,
               "config": {"displaylogo": False, "responsive": True}}
-    return figure, len(agents), len(times)
+    return figure, (len(agents), len(all_agents)), (len(times), len(all_times))

@@ -1,0 +1,135 @@
+"""What a map is: :class:`TopologicalMap`, its regions and their windows (data only).
+
+Its JSON document (map.json) and its advice to the user are written at the edges
+(:mod:`swarmtopo.viz.summary`).
+"""
+
+from __future__ import annotations
+
+import platform
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .. import __version__
+from ..metric.landmarks import Landmarks
+from ..readers.beta0 import Beta0Evidence
+from ..topology.cycles import Cycle
+from ..topology.embed import Embedding
+from ..topology.persistence import Diagram, PersistenceResult
+from .config import WHOLE_LOG, MapConfig
+
+
+@dataclass(frozen=True)
+class RegionScales:
+    """Scales of one window's event cloud, in the metric's unit (seconds).
+
+    knn
+        s: median over distinct events of the mean distance to their k nearest others.
+    cover_radius
+        r_cover of the landmark set.
+    """
+
+    knn: float
+    cover_radius: float
+
+
+@dataclass(eq=False)
+class WindowMap:
+    """One region's events in one time window [t0, t1], mapped with the landmarks of one band."""
+
+    t0: float
+    t1: float
+    n_events: int
+    landmarks: Landmarks
+    landmark_events: np.ndarray  # (L,) original log event index of each landmark
+    scales: RegionScales
+    persistence: PersistenceResult
+    band: float = 1.0  # the middle share of the window its landmarks were drawn from
+    betti: dict[int, int] = field(default_factory=dict)  # this window's own count
+
+    @property
+    def diagram(self) -> Diagram:
+        return self.persistence.diagram
+
+
+@dataclass(eq=False)
+class RegionMap:
+    """One region: a connected component of the encounter graph with enough events.
+
+    Its landmarks, diagram, loops and picture are those of its representative window
+    ``windows[window]``; ``betti`` is the reader's pooled count over all its windows.
+    """
+
+    component: int
+    n_events: int
+    n_agents: int
+    landmarks: Landmarks
+    landmark_events: np.ndarray  # (L,) original log event index of each landmark
+    diagram: Diagram
+    scales: RegionScales
+    thresholds: dict[int, float]  # bar-length threshold per dimension n >= 1
+    counted: dict[int, np.ndarray]  # indices of the counted bars of the diagram, per dimension n >= 1
+    betti: dict[int, int]
+    confidence: dict[int, float | None]  # P(betti[n] is right), n >= 1
+    cycles: list[Cycle]  # a loop of landmarks round each counted H1 bar (empty if not asked)
+    warnings: list[str]
+    embedding: Embedding | None
+    windows: list[WindowMap]
+    window: int  # index of the representative window
+
+
+@dataclass(eq=False)
+class TopologicalMap:
+    """The result of mapping an encounter log.
+
+    ``betti[n]`` is the estimated n-th Betti number: beta_0 counts regions, beta_1
+    holes (None for a dimension the reader has no threshold for).  ``confidence[n]`` is
+    the probability that ``betti[n]`` is right: beta_0's from :mod:`swarmtopo.readers.beta0`
+    (read from ``beta0_evidence``); for n >= 1 one region's, or for several the reader's
+    combination of the regions' (:meth:`~swarmtopo.readers.base.BettiReader.map_confidence`).
+    ``diagram`` is the union of the regions' diagrams.
+    """
+
+    betti: dict[int, int | None]
+    confidence: dict[int, float | None]
+    diagram: Diagram
+    regions: list[RegionMap]
+    too_little_data: list[dict[str, int]]
+    classifier: dict[str, Any]
+    config: MapConfig
+    timings: dict[str, float]
+    n_events: int
+    n_agents: int
+    hop_cost: tuple[float, str] = (0.0, "given")  # (h used, where it came from)
+    diffusion_time: tuple[float, str] = (WHOLE_LOG, "given")  # (tau used, where it came from)
+    window_length: tuple[float, str] = (WHOLE_LOG, "given")  # (window length used, where it came from)
+    windows_left_out: int = 0  # windows the cap (MapConfig.max_windows) left unmapped
+    software: dict[str, str] = field(default_factory=dict)
+    log_warnings: list[str] = field(default_factory=list)  # about the mapped log as a whole
+    beta0_evidence: Beta0Evidence | None = None  # what beta_0's confidence was read from
+    contact_trace: bool = False  # the log has no status changes (read as a contact trace)
+
+    @property
+    def warnings(self) -> list[str]:
+        """Reasons to doubt the map: the log's, then every region's."""
+        return self.log_warnings + [w for r in self.regions for w in r.warnings]
+
+
+def software_versions() -> dict[str, str]:
+    """Versions of swarmtopo and the libraries whose numbers it reports."""
+    import gudhi
+    import ripser
+    import scipy
+    import sklearn
+
+    return {
+        "swarmtopo": __version__,
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "gudhi": gudhi.__version__,
+        "ripser": ripser.__version__,
+        "scikit-learn": sklearn.__version__,
+    }

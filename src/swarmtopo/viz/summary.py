@@ -1,0 +1,104 @@
+"""A map for people and files: its map.json document and its advice.
+
+:func:`map_json` is the map.json document (deaths of infinite bars as null);
+:func:`advice` says what would raise a confidence below ``ADVICE_BELOW``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+from typing import Any
+
+import numpy as np
+
+from .._json import jsonable
+from ..pipeline.result import RegionMap, TopologicalMap, WindowMap
+from ..readers.beta0 import BETA0_DEFINITION
+from ..readers.ratio import RESOLUTION_CAP, below_full_resolution, resolution
+
+ADVICE_BELOW = 0.9
+"""A Betti number reported with less confidence than this comes with advice."""
+
+
+def advice(tmap: TopologicalMap) -> list[str]:
+    """What would raise a confidence below ``ADVICE_BELOW`` (empty otherwise)."""
+    low = [n for n, p in sorted(tmap.confidence.items()) if p is not None and p < ADVICE_BELOW]
+    if not low:
+        return []
+    lines = [f"beta_{n} = {tmap.betti[n]} is uncertain ({100 * tmap.confidence[n]:.0f}% confidence)" for n in low]
+    evidence = tmap.beta0_evidence
+    if 0 in low and evidence is not None:
+        apart = (f"have stayed apart for only {evidence.settled:.3g} mean gaps between an agent's encounters since "
+                 "they formed" if evidence.settled else "formed at the log's end (or no agent met twice)")
+        lines.append(
+            f"the {evidence.regions} regions {apart}; groups in one room merge when their agents meet, so only a "
+            "longer log tells one room from several" if evidence.regions >= 2 else
+            f"{100 * evidence.fragments:.0f}% of the events are in groups too small to map (too_little_data); "
+            "a room only a few agents saw would hide there")
+    for r in tmap.regions:
+        counts = [w.betti.get(1) for w in r.windows]
+        if len(set(counts)) > 1:
+            lines.append(f"region {r.component}: its {len(counts)} time windows counted {counts} holes each")
+        if 1 in low and below_full_resolution(diagrams := [w.diagram for w in r.windows]):
+            lines.append(f"region {r.component}: its windows tell about {np.exp(resolution(diagrams)):.0f} places "
+                         f"apart (landmarks; {RESOLUTION_CAP} at full resolution): with few places a hole can go "
+                         "unseen in every window alike, so agreeing windows are no proof")
+    length = tmap.window_length[0]
+    more_time = ("" if tmap.windows_left_out else
+                 f"record longer (each extra {tmap.config.window_step or length / 2:.3g} s adds a window to "
+                 "the pooling), " if np.isfinite(length) else "record longer, ")
+    how_much = ("'swarmtopo plan " + ("--input contact-trace " if tmap.contact_trace else "")
+                + "--area A --agents N --target 0.95' tells how much")
+    lines.append(f"to raise it: {more_time}use more agents than {tmap.n_agents} (denser windows); {how_much}")
+    return lines
+
+
+def map_json(tmap: TopologicalMap) -> dict[str, Any]:
+    """The map.json document (deaths of infinite bars as null)."""
+    return {
+        "betti": {str(k): v for k, v in sorted(tmap.betti.items())},
+        "confidence": {str(k): v for k, v in sorted(tmap.confidence.items())},
+        "diagrams": tmap.diagram.to_json(),
+        "classifier": tmap.classifier,
+        "warnings": tmap.warnings,
+        "advice": advice(tmap),
+        "regions": [_region_json(r) for r in tmap.regions],
+        "too_little_data": tmap.too_little_data,
+        "beta0_evidence": None if tmap.beta0_evidence is None else {**tmap.beta0_evidence.to_json(),
+                                                                      "definition": BETA0_DEFINITION},
+        "params": {**jsonable(asdict(tmap.config)), "hop_cost_used": tmap.hop_cost[0],
+                   "hop_cost_source": tmap.hop_cost[1],
+                   "diffusion_time_used": tmap.diffusion_time[0] if np.isfinite(tmap.diffusion_time[0]) else None,
+                   "diffusion_time_source": tmap.diffusion_time[1],
+                   "window_length_used": tmap.window_length[0] if np.isfinite(tmap.window_length[0]) else None,
+                   "window_source": tmap.window_length[1], "windows_left_out": tmap.windows_left_out},
+        "log": {"events": tmap.n_events, "agents": tmap.n_agents, "contact_trace": tmap.contact_trace},
+        "timings": {k: round(v, 6) for k, v in tmap.timings.items()},
+        "software": {**tmap.software, "persistence_backend": tmap.diagram.backend},
+    }
+
+
+def _region_json(r: RegionMap) -> dict[str, Any]:
+    return {
+        "component": r.component,
+        "events": r.n_events,
+        "agents": r.n_agents,
+        "landmarks": int(len(r.landmarks.nodes)),
+        "cover_radius": float(r.scales.cover_radius),
+        "knn_scale": float(r.scales.knn),
+        "thresholds": {str(n): float(v) for n, v in r.thresholds.items()},
+        "betti": {str(k): int(v) for k, v in sorted(r.betti.items())},
+        "confidence": {str(k): v for k, v in sorted(r.confidence.items())},
+        "cycles": [c.to_json() for c in r.cycles],
+        "windows": [window_json(w) for w in r.windows],
+        "window": r.window,
+        "diagrams": r.diagram.to_json(),
+        "mds_stress": None if r.embedding is None else float(r.embedding.stress),
+        "warnings": r.warnings,
+    }
+
+
+def window_json(w: WindowMap) -> dict[str, Any]:
+    return {"t0": w.t0, "t1": w.t1, "band": w.band, "events": w.n_events, "landmarks": int(len(w.landmarks.nodes)),
+            "cover_radius": float(w.scales.cover_radius), "knn_scale": float(w.scales.knn),
+            "betti": {str(n): int(v) for n, v in w.betti.items()}}
