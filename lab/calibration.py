@@ -44,7 +44,7 @@ import numpy as np
 from sklearn.metrics import log_loss
 from sklearn.model_selection import KFold, cross_val_predict
 
-from swarmtopo.readers.paper import load_classifier
+from swarmtopo.readers.registry import load_classifier
 from swarmtopo.experiments.accuracy import CELLS, PLANNING_CELLS, REPORTING_PER_CELL, brier_gain, cell_of, reliability
 from swarmtopo.experiments.store import read_jobs
 from swarmtopo.experiments.sweep import INPUTS, map_input

@@ -14,7 +14,7 @@ fixed arenas are in neither the tuning nor the training cases.
 import argparse
 
 from swarmtopo.arena import default_arena, square_arena
-from swarmtopo.readers.paper import load_classifier
+from swarmtopo.readers.registry import load_classifier
 from swarmtopo.pipeline.config import WHOLE_LOG
 from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.sim import simulate

@@ -39,7 +39,8 @@ from sklearn.preprocessing import StandardScaler
 from calibration import default_maps
 from swarmtopo.experiments.accuracy import CELLS
 from tuning import cross_validated_exact
-from swarmtopo.readers.ratio import LOG_RATIO_CAP, longest_bars, noise_length, score_matrix
+from swarmtopo.readers.base import longest_bars
+from swarmtopo.readers.ratio import LOG_RATIO_CAP, noise_length, score_matrix
 
 RANKS = 6
 """Ranks per region a learned model reads (the suite's arenas have at most 3 holes per region)."""

@@ -30,7 +30,7 @@ import sys
 
 import numpy as np
 
-from swarmtopo.readers.paper import load_classifier
+from swarmtopo.readers.registry import load_classifier
 from swarmtopo.experiments.accuracy import (PIPELINES, PLANNING_BUDGETS, PLANNING_CELLS, PLANNING_PER_CELL,
                                             REPORTING_PER_CELL, TRACE_PIPELINE, outcomes, planning_jobs,
                                             reporting_jobs)

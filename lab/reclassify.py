@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import argparse
 
-from swarmtopo.readers.paper import load_classifier
+from swarmtopo.readers.registry import load_classifier
 from swarmtopo.readers.ratio import RatioClassifier, RatioThresholds
 from swarmtopo.experiments.accuracy import (CELLS, PIPELINES, PLANNING_CELLS, accuracy_table, beta1_misses,
                                             most_windows, outcomes, reading_name, reliability,

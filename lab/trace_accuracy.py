@@ -32,7 +32,7 @@ import sys
 import time
 
 from reclassify import planning_summary
-from swarmtopo.readers.paper import load_classifier
+from swarmtopo.readers.registry import load_classifier
 from swarmtopo.experiments.accuracy import (CELLS, PIPELINES, PLANNING_CELLS, QUICK_PER_CELL, REPORTING_PER_CELL,
                                             TRACE_PIPELINE, accuracy_table, beta1_misses, most_windows, outcomes,
                                             planning_jobs, rate_text, reliability, reporting_jobs)

@@ -33,7 +33,7 @@ they give the shipped thresholds, and rewrites those classifiers' confidence alo
 
 ``--regions-only [default] [trace]`` maps only the tuning cases of the cells whose arenas
 have several regions (two rooms) and refits only the named classifiers'
-``regions_exponent`` (:func:`~swarmtopo.readers.ratio.map_confidence`), reading those maps with
+``regions_exponent`` (:meth:`~swarmtopo.readers.ratio.RatioClassifier.map_confidence`), reading those maps with
 the shipped thresholds and regional model: what the full and ``--calibrate-only`` runs
 fit last.  Either way the script prints the several-region maps' Brier score and log
 loss under the plain product, the power a cross-fitted over 10 folds, and a constant.

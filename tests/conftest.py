@@ -27,6 +27,20 @@ settings.register_profile("ci", derandomize=True)
 if os.environ.get("CI"):
     settings.load_profile("ci")
 
+
+def pytest_collection_modifyitems(items):
+    """Modules holding a test marked ``slow`` first, each module's tests kept together
+    and in order: with one module per worker (``--dist loadscope``), a long module
+    started last would leave the other worker idle while it finishes."""
+
+    def module(item):
+        return item.nodeid.split("::", 1)[0]
+
+    slow = {module(item) for item in items if item.get_closest_marker("slow")}
+    rank = {name: (name not in slow, i) for i, name in enumerate(dict.fromkeys(map(module, items)))}
+    items.sort(key=lambda item: rank[module(item)])
+
+
 TWO_ROOMS_GEOJSON = {"type": "MultiPolygon", "coordinates": [
     [[[0, 0], [500, 0], [500, 500], [0, 500], [0, 0]]],
     [[[600, 0], [1100, 0], [1100, 500], [600, 500], [600, 0]],
@@ -46,11 +60,11 @@ def run_cli(*args, cwd=None, env=None) -> subprocess.CompletedProcess:
     the imports of start-up, output written by C code straight to the file descriptors,
     the exit code of a crash -- needs ``python -m swarmtopo`` in a subprocess.
     """
-    from swarmtopo import cli
+    from swarmtopo import cli as command_line
 
     argv = ["swarmtopo", *map(str, args)]
     stdout, stderr = io.StringIO(), io.StringIO()
-    app, saved_argv, saved_env = cli.app, sys.argv, dict(os.environ)
+    app, saved_argv, saved_env = command_line.app, sys.argv, dict(os.environ)
 
     def show(message, category, filename, lineno, file=None, line=None):
         stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
@@ -67,9 +81,9 @@ def run_cli(*args, cwd=None, env=None) -> subprocess.CompletedProcess:
             os.environ.clear()
             os.environ.update(env)
         sys.argv = argv
-        cli.app = lambda **kwargs: app(prog_name="swarmtopo", **kwargs)
+        command_line.app = lambda **kwargs: app(prog_name="swarmtopo", **kwargs)
         try:
-            cli.main()
+            command_line.main()
         except SystemExit as exc:
             if exc.code is None or isinstance(exc.code, int):
                 code = exc.code or 0
@@ -77,7 +91,7 @@ def run_cli(*args, cwd=None, env=None) -> subprocess.CompletedProcess:
                 print(exc.code, file=sys.stderr)
                 code = 1
         finally:
-            cli.app, sys.argv = app, saved_argv
+            command_line.app, sys.argv = app, saved_argv
             if env is not None:
                 os.environ.clear()
                 os.environ.update(saved_env)

@@ -10,12 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from swarmtopo.readers.paper import load_classifier
+from swarmtopo.readers.registry import load_classifier
 from swarmtopo.errors import SwarmtopoError
 from swarmtopo.experiments import accuracy as acc
 from swarmtopo.experiments.grid import canonical_json
 from swarmtopo.experiments.sweep import run_job
-from swarmtopo.pipeline.map import fitted_landmark_bands
 
 ROOT = Path(__file__).resolve().parent.parent
 FROZEN_DIGEST = "6e330f11fbcbae30"
@@ -145,7 +144,7 @@ def test_table_and_reliability_hand_computed():
 
 def test_outcomes_read_a_two_region_map_by_the_classifiers_power_of_the_product():
     from swarmtopo.topology.persistence import Diagram
-    from swarmtopo.readers.ratio import map_confidence, vote
+    from swarmtopo.readers.base import vote
 
     def region(long_bar):  # three windows, ten noise loops each, and one long loop or none
         rng = np.random.default_rng(int(long_bar))
@@ -167,7 +166,7 @@ def test_outcomes_read_a_two_region_map_by_the_classifiers_power_of_the_product(
     a = classifier.calibration_["1"]["regions_exponent"]
     assert record["est_betti1"] == 1 and record["right"]
     assert record["confidence_betti1"] == pytest.approx(np.prod(confidences) ** a)
-    assert record["confidence_betti1"] == pytest.approx(map_confidence(classifier, confidences))
+    assert record["confidence_betti1"] == pytest.approx(classifier.map_confidence(confidences))
     assert record["confidence_betti1"] > np.prod(confidences)  # 0 < a < 1
 
 
@@ -187,6 +186,7 @@ def test_brier_gain_interval_separates_a_sharp_confidence_from_the_constant():
     np.testing.assert_allclose(acc.brier_gain(p[rows], y[rows]), literal)
 
 
+@pytest.mark.slow
 def test_benchmark_runs_both_pipelines_on_dask_and_renders_its_table(tmp_path):
     cells = (acc.CELLS[0], acc.CELLS[-1])  # 0 holes and two rooms, smallest budgets
     summary = acc.run_benchmark(tmp_path / "acc.duckdb", per_cell=1, cells=cells, workers=1)
@@ -248,7 +248,7 @@ def test_contact_trace_keeps_only_the_encounters_and_maps_from_them():
     assert row["diagrams"] != default_row["diagrams"]  # mapped with other weights (h from the data, no wall following)
     # classifier "default" is map's: the trace classifier for a trace, and the bands each was fitted with
     assert (row["versions"]["classifier"], default_row["versions"]["classifier"]) == ("trace", "default")
-    assert {w["band"] for r in row["diagrams"] for w in r["windows"]} == set(fitted_landmark_bands(load_classifier("trace")))
+    assert {w["band"] for r in row["diagrams"] for w in r["windows"]} == set(load_classifier("trace").landmark_bands)
     assert {w["band"] for r in default_row["diagrams"] for w in r["windows"]} == set(acc.PIPELINES["default"]["landmark_bands"])
     bogus = acc.reporting_jobs(1, pipelines={"bogus": {**trace_pipeline, "input": "video"}}, cells=acc.CELLS[3:4])
     with pytest.raises(ValueError, match="map input 'video' is not one of"):
@@ -258,10 +258,10 @@ def test_contact_trace_keeps_only_the_encounters_and_maps_from_them():
 def test_benchmark_pipelines_map_as_their_classifiers_were_fitted():
     """The default pipeline's bands are the ones the shipped default classifier was fitted
     with (what ``map`` uses when none are given); contact traces keep the trace classifier's."""
-    assert fitted_landmark_bands(load_classifier("default")) == tuple(acc.PIPELINES["default"]["landmark_bands"])
+    assert load_classifier("default").landmark_bands == tuple(acc.PIPELINES["default"]["landmark_bands"])
     assert load_classifier("default").provenance_["pipeline"]["landmark_bands"] == acc.PIPELINES["default"]["landmark_bands"]
-    assert "landmark_bands" not in acc.TRACE_PIPELINE and fitted_landmark_bands(load_classifier("trace")) == (1.0,)
-    assert "landmark_bands" not in acc.PIPELINES["paper"] and fitted_landmark_bands(load_classifier("paper-form")) == (1.0,)
+    assert "landmark_bands" not in acc.TRACE_PIPELINE and load_classifier("trace").landmark_bands == (1.0,)
+    assert "landmark_bands" not in acc.PIPELINES["paper"] and load_classifier("paper").landmark_bands == (1.0,)
 
 
 def test_most_windows_is_the_largest_region_of_the_stored_maps():

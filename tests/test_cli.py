@@ -1,31 +1,35 @@
-"""The command line as a user meets it: real processes, exit codes, stdout/stderr."""
+"""The command line as a user meets it: exit codes, stdout/stderr.
+
+Most runs are in-process (``conftest.run_cli``: the CLI's start-up is most of a short
+run); what only a real process shows -- an exit code as the shell sees it, nothing
+written to the file descriptors by C code, the version as installed -- runs
+``python -m swarmtopo`` (:func:`run_process`)."""
 
 import json
 import os
 import subprocess
 import sys
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import run_cli as run
 
-from swarmtopo.readers.paper import load_classifier
+from swarmtopo.readers.registry import load_classifier
 from swarmtopo.io import read_log, strip_ground_truth
 from swarmtopo.pipeline import MapConfig
 from swarmtopo.viz.text import format_confidence
 
 
-def run(*args, cwd=None):
+def run_process(*args, cwd=None, env=None):
+    """``python -m swarmtopo ARGS`` in a new process."""
     return subprocess.run([sys.executable, "-m", "swarmtopo", *map(str, args)], capture_output=True,
-                          text=True, cwd=cwd, timeout=300)
+                          text=True, cwd=cwd, env=env, timeout=300)
 
 
 def run_all(*commands):
-    """:func:`run` of each command (a tuple of arguments), as many at once as the machine
-    has cores: a short run is mostly the CLI's start-up."""
-    with ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
-        return list(pool.map(lambda args: run(*args), commands))
+    """:func:`run` of each command (a tuple of arguments), one after the other."""
+    return [run(*args) for args in commands]
 
 
 def assert_one_line_error(proc, *fragments, code=1):
@@ -46,12 +50,10 @@ def assert_one_line_errors(*cases):
 
 
 @pytest.fixture(scope="module")
-def simulated(tmp_path_factory):
-    out = tmp_path_factory.mktemp("sim") / "log"
-    proc = run("simulate", "--holes", 1, "--agents", 200, "--duration", 20, "--seed", 4, "--truth",
-               "--trajectories", 1.0, "--out", out)
-    assert proc.returncode == 0, proc.stderr
-    return out, proc
+def simulated(one_hole_log):
+    """``swarmtopo simulate --holes 1 --agents 200 --duration 20 --seed 4 --truth
+    --trajectories 1`` (conftest): (folder, run)."""
+    return one_hole_log
 
 
 def test_simulate_writes_the_log_folder(simulated):
@@ -189,7 +191,7 @@ def test_out_that_is_a_file_is_one_line(simulated, tmp_path):
 
 
 def test_missing_folder_is_one_line(tmp_path):
-    assert_one_line_error(run("map", tmp_path / "nowhere"), f"{tmp_path / 'nowhere'}: log folder not found")
+    assert_one_line_error(run_process("map", tmp_path / "nowhere"), f"{tmp_path / 'nowhere'}: log folder not found")
     assert list(tmp_path.iterdir()) == []  # not made by the map's default --out nowhere/map
 
 
@@ -361,13 +363,14 @@ def test_quiet_verbose_and_pipes(tmp_path, simulated):
     # in a pipe a normal run prints its verdict and no progress; --quiet prints nothing
     normal = run("map", simulated[0], "--out", tmp_path / "n", "--landmarks", 100)
     assert normal.returncode == 0 and "recovered:" in normal.stdout and normal.stderr == ""
-    quiet = run("map", simulated[0], "--out", tmp_path / "q", "--landmarks", 100, "--quiet")
+    quiet = run_process("map", simulated[0], "--out", tmp_path / "q", "--landmarks", 100, "--quiet")
     assert quiet.returncode == 0 and quiet.stdout == "" and quiet.stderr == ""
     # --verbose adds each stage's time and each region's details on stderr, same result
     verbose = run("map", simulated[0], "--out", tmp_path / "v", "--landmarks", 100, "--verbose")
     assert verbose.returncode == 0 and verbose.stdout == normal.stdout.replace(str(tmp_path / "n"), str(tmp_path / "v"))
     assert "stages: graph" in verbose.stderr and "region 0:" in verbose.stderr
-    assert_one_line_error(run("map", simulated[0], "-q", "-v"), "--quiet and --verbose exclude each other", code=2)
+    assert_one_line_error(run_process("map", simulated[0], "-q", "-v"), "--quiet and --verbose exclude each other",
+                          code=2)
 
 
 def test_map_paper_and_pipeline_options(simulated, tmp_path):
@@ -445,7 +448,7 @@ def test_bench_and_plan_help_show_examples():
 def test_version():
     from importlib.metadata import version
 
-    proc = run("--version")
+    proc = run_process("--version")
     assert proc.returncode == 0 and proc.stdout == f"swarmtopo {version('swarmtopo')}\n" and proc.stderr == ""
 
 
@@ -455,8 +458,7 @@ def test_help_sends_nobody_to_files_they_do_not_have(command):
     """A pip install has no docs/ folder: a pointer to one says it is in the source repository."""
     import re
 
-    proc = subprocess.run([sys.executable, "-m", "swarmtopo", *command, "--help"], capture_output=True, text=True,
-                          timeout=300, env={**os.environ, "COLUMNS": "100"})
+    proc = run(*command, "--help", env={**os.environ, "COLUMNS": "100"})
     assert proc.returncode == 0, proc.stderr
     text = re.sub(r"[\s│]+", " ", proc.stdout)  # the help as one line, without Rich's box
     assert "Usage:" in text

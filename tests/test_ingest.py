@@ -6,8 +6,6 @@ from __future__ import annotations
 import gzip
 import json
 import os
-import subprocess
-import sys
 
 import numpy as np
 import pyarrow as pa
@@ -182,8 +180,7 @@ def test_streaming_blocks_give_the_same_log_as_one_block(tmp_path, monkeypatch):
 
 
 # -- CLI -----------------------------------------------------------------------------------
-def run_cli(*args):
-    return subprocess.run([sys.executable, "-m", "swarmtopo", *map(str, args)], capture_output=True, text=True)
+from conftest import run_cli  # noqa: E402  (the CLI in-process)
 
 
 def test_cli_ingest_then_map(tmp_path):

@@ -15,7 +15,6 @@ from swarmtopo.pipeline.config import WHOLE_LOG, ConfigError, config_from_option
 from swarmtopo.pipeline.map import share_landmarks
 from swarmtopo.pipeline.settings import DIFFUSION_GAP_FACTOR, HOP_GAP_FACTOR, mean_agent_gap
 from swarmtopo.pipeline.windows import scaled_windows, window_length, window_spans
-from swarmtopo.readers.ratio import RatioClassifier, RatioThresholds
 from swarmtopo.readers.registry import load_classifier, shipped_reader_for
 from swarmtopo.viz.summary import advice, map_json, window_json
 from swarmtopo.sim import simulate
@@ -542,7 +541,7 @@ def test_advice_comes_below_the_threshold_and_names_what_would_raise_it():
     assert advice(sure) == [] and map_json(sure)["advice"] == []
     unsure = dataclasses.replace(tmap, confidence={0: 0.99, 1: ADVICE_BELOW - 0.2})
     lines = advice(unsure)
-    assert lines[0] == f"beta_1 = {tmap.betti[1]} is uncertain ({100 * (ADVICE_BELOW - 0.2):.0f}% confidence)"
+    assert lines[0] == f"beta_1 = {tmap.betti[1]} is uncertain (70.0% confidence)"  # as the CLI and report say it
     assert lines[-1].startswith("to raise it: record longer") and "more agents than 150" in lines[-1]
     assert "swarmtopo plan" in lines[-1] and map_json(unsure)["advice"] == lines
     # the windows' resolution, the confidence's second feature, is named when beta_1 is in doubt

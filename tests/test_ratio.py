@@ -12,11 +12,12 @@ from sklearn.base import clone
 
 from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.pipeline import MapConfig
+from swarmtopo.readers.base import longest_bars, median_vote, vote
 from swarmtopo.readers.ratio import (LOG_RATIO_CAP, MAX_MARGIN, RATIO_FORMAT, REGIONS_EXPONENT, RESOLUTION_CAP,
                                      SCORE_VAR_PRIOR, SPAN_FEATURES, Z_CAP, RatioClassifier, RatioThresholds,
-                                     below_full_resolution, calibrated_probability, confidence_readout, longest_bars,
-                                     map_confidence, median_vote, pooled_scores, resolution, score_margin,
-                                     score_matrix, standardised_margin, vote, window_scores, windows_span)
+                                     below_full_resolution, calibrated_probability, confidence_readout,
+                                     pooled_scores, resolution, score_margin, score_matrix, standardised_margin,
+                                     window_scores, windows_span)
 from swarmtopo.readers.registry import load_classifier
 from swarmtopo.topology.persistence import Diagram
 
@@ -203,19 +204,19 @@ def test_a_map_of_several_regions_raises_the_product_of_their_confidences_to_the
     calibration = {"intercept": -3.0, "z": 1.2, "maps": 10}
     plain = ratio(TH, calibration={"1": calibration})
     powered = ratio(TH, calibration={"1": {**calibration, REGIONS_EXPONENT: 0.5}})
-    assert map_confidence(plain, [0.9, 0.8]) == pytest.approx(0.72)  # no exponent: the plain product
-    assert map_confidence(powered, [0.9, 0.8]) == pytest.approx(0.72 ** 0.5)
-    assert map_confidence(powered, [0.9, 0.8, 0.5]) == pytest.approx(0.36 ** 0.5)
-    assert map_confidence(powered, [0.9]) == 0.9  # one region: its own confidence, never powered
-    assert map_confidence(powered, [0.9, None]) is None and map_confidence(powered, []) is None
-    assert map_confidence(powered, [0.9, 0.8], n=2) == pytest.approx(0.72)  # fitted for beta_1 only
-    assert map_confidence(object(), [0.9, 0.8]) == pytest.approx(0.72)  # a classifier without calibration
+    assert plain.map_confidence([0.9, 0.8]) == pytest.approx(0.72)  # no exponent: the plain product
+    assert powered.map_confidence([0.9, 0.8]) == pytest.approx(0.72 ** 0.5)
+    assert powered.map_confidence([0.9, 0.8, 0.5]) == pytest.approx(0.36 ** 0.5)
+    assert powered.map_confidence([0.9]) == 0.9  # one region: its own confidence, never powered
+    assert powered.map_confidence([0.9, None]) is None and powered.map_confidence([]) is None
+    assert powered.map_confidence([0.9, 0.8], n=2) == pytest.approx(0.72)  # fitted for beta_1 only
+    assert load_classifier("paper").map_confidence([0.9, 0.8]) == pytest.approx(0.72)  # the paper's: the product
     # the exponent is not a feature: the regional confidence is the same with or without it
     windows = [with_landmarks(20)] * 3
     assert powered.region_confidence(windows)[1] == plain.region_confidence(windows)[1]
     assert "to the power 0.5" in powered.describe()["confidence"]
     restored = RatioClassifier.from_json(powered.to_json())
-    assert restored.calibration_ == powered.calibration_ and map_confidence(restored, [0.9, 0.8]) == pytest.approx(
+    assert restored.calibration_ == powered.calibration_ and restored.map_confidence([0.9, 0.8]) == pytest.approx(
         0.72 ** 0.5)
     # a refit of the regional model drops the power, and the provenance that it was fitted
     powered.provenance_["regions_calibration"] = "fitted on 96 several-region tuning maps"
@@ -232,7 +233,7 @@ def test_the_shipped_classifiers_power_raises_a_several_region_confidence():
     for name in ("default", "trace"):
         a = load_classifier(name).calibration_["1"][REGIONS_EXPONENT]
         assert 0 < a < 1
-        assert map_confidence(load_classifier(name), [0.9, 0.9]) > 0.81
+        assert load_classifier(name).map_confidence([0.9, 0.9]) > 0.81
 
 
 def test_windows_span_is_the_first_start_to_the_last_end():

@@ -19,26 +19,22 @@ import numpy as np
 import pytest
 from hypothesis import given, strategies as st
 
-from swarmtopo.arena import default_arena
 from swarmtopo.log import EncounterLog, state_labels
 from swarmtopo.pipeline import MapConfig, map_encounters
-from swarmtopo.viz.report import write_map_outputs
+from swarmtopo.viz.report import write_map
 from swarmtopo.viz.report_html import MAX_ANIMATION_AGENTS, script_json
 from swarmtopo.viz.text import format_confidence
-from swarmtopo.sim import simulate
 
 EVIL = "<script>alert(1)</script>"
 EVIL_IMG = "<img src=x onerror=alert(2)>"
 
 
 @pytest.fixture(scope="module")
-def demo(tmp_path_factory):
+def demo(demo_run, demo_map, tmp_path_factory):
     """The demo scenario (one hole, 200 agents, 30 s) mapped, with truth and trajectories."""
-    arena = default_arena()
-    sim = simulate(arena, 200, 30.0, rng=0, truth=True, trajectory_every=1.0)
-    tmap = map_encounters(sim.log, MapConfig(seed=0))
+    sim, tmap, arena = demo_run, demo_map, demo_run.arena
     out = tmp_path_factory.mktemp("report")
-    write_map_outputs(tmap, out, log=sim.log, truth=sim.truth, arena=arena, trajectories=sim.trajectories)
+    write_map(tmap, out, log=sim.log, truth=sim.truth, arena=arena, trajectories=sim.trajectories)
     return {"sim": sim, "arena": arena, "out": out, "html": (out / "report.html").read_text(encoding="utf-8"),
             "map": json.loads((out / "map.json").read_text(encoding="utf-8"))}
 
@@ -59,7 +55,7 @@ def evil(demo, tmp_path_factory):
     trajectories = dict(sim.trajectories, agent=ids[sim.trajectories["agent"]])
     tmap = map_encounters(evil_log, MapConfig(seed=0))
     out = tmp_path_factory.mktemp("evil")
-    write_map_outputs(tmap, out, log=evil_log, truth=sim.truth, arena=demo["arena"], trajectories=trajectories)
+    write_map(tmap, out, log=evil_log, truth=sim.truth, arena=demo["arena"], trajectories=trajectories)
     return {"out": out, "html": (out / "report.html").read_text(encoding="utf-8")}
 
 

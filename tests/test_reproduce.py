@@ -7,7 +7,7 @@ import csv
 import numpy as np
 import pytest
 
-from swarmtopo.readers.paper import load_classifier
+from swarmtopo.readers.registry import load_classifier
 
 from swarmtopo.arena import default_arena
 from swarmtopo.topology.cycles import event_positions
@@ -134,7 +134,7 @@ def test_encmds_table_matches_the_pipeline_on_its_seeds(encmds_two_runs):
         sim = simulate(default_arena(), rp.AGENTS, rp.DURATION, rng=int(row["seed"]))
         paper = MapConfig(metric="plain", hop_cost=0.0, diffusion_time=WHOLE_LOG, wall_follow_weight=None,
                           window_length=WHOLE_LOG, embed_dim=0)
-        tmap = map_encounters(sim.log, paper, classifier=load_classifier(rp.PAPER_CLASSIFIER))
+        tmap = map_encounters(sim.log, paper, reader=load_classifier(rp.PAPER_CLASSIFIER))
         assert int(row["beta_1"]) == tmap.betti[1]
         assert number(row["longest_h1"]) == tmap.diagram.lengths(1)[0]
         assert number(row["snr"]) == snr(tmap.diagram, 1, 1).ratio

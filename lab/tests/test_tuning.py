@@ -10,7 +10,7 @@ from tuning import (TuningMap, calibrated_classifier, cross_fitted_features, cro
                     fit_regions_exponent, fit_thresholds, maps_from_rows, regions_exponent_scores,
                     several_region_products, training_set)
 from swarmtopo.readers.ratio import (CONFIDENCE_FEATURES, Q_GRID, REGIONS_EXPONENT, TAU_GRID, RatioClassifier,
-                                     RatioThresholds, grid_estimates, map_confidence)
+                                     RatioThresholds, grid_estimates)
 from swarmtopo.topology.persistence import Diagram
 
 
@@ -142,7 +142,7 @@ def test_several_region_products_are_the_literal_regions_product_and_join_the_ca
     assert a == pytest.approx(fit_regions_exponent(log_products, right))
     assert model.provenance_["regions_calibration"] == "fitted on 12 several-region tuning maps"
     confidences = [model.region_confidence(region)[1] for region in rooms[0].regions]
-    assert map_confidence(model, confidences) == pytest.approx(np.prod(confidences) ** a)
+    assert model.map_confidence(confidences) == pytest.approx(np.prod(confidences) ** a)
     # a one-room arena that a sparse log split in two is not a map of rooms: left out of the fit
     split = dataclasses.replace(rooms[0], true_betti0=1, true_betti1=rooms[0].true_betti1)
     assert len(several_region_products([split] + rooms, model)[1]) == 12

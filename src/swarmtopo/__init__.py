@@ -54,8 +54,6 @@ _PUBLIC = {
     "InputError": "swarmtopo.errors",
     "ArenaError": "swarmtopo.errors",
 }
-_RENAMED = {"write_map": "write_map_outputs"}
-
 __all__ = sorted(_PUBLIC) + ["__version__"]
 
 
@@ -63,7 +61,7 @@ def __getattr__(name: str):
     """Load a public name on first use (PEP 562)."""
     if name not in _PUBLIC:
         raise AttributeError(f"module 'swarmtopo' has no attribute {name!r}")
-    value = getattr(import_module(_PUBLIC[name]), _RENAMED.get(name, name))
+    value = getattr(import_module(_PUBLIC[name]), name)
     globals()[name] = value
     return value
 

@@ -66,18 +66,6 @@ def check_format(obj, expected: str | tuple[str, ...], what: str, source: str) -
     return obj
 
 
-def file_calibration(calibration, source: str) -> dict:
-    """A classifier file's ``calibration`` object ({dimension: model}; none: {}) without
-    earlier files' "0" (beta_0's confidence is now the pipeline's, swarmtopo.readers.beta0); a
-    value that is not an object is refused naming ``source``."""
-    if not calibration:
-        return {}
-    if not isinstance(calibration, dict):
-        raise InputError("must be an object of {dimension: model}", file=source, column="calibration",
-                         value=calibration)
-    return {n: c for n, c in calibration.items() if n != "0"}
-
-
 def _real(name: str, value, allow_inf: bool) -> float:
     """float(value) for a real number (NaN and, unless allowed, inf included: the
     callers' range checks refuse them with their own message)."""

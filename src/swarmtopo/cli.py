@@ -328,8 +328,9 @@ def map_command(
                                                           "hybrid)."),
     subsample: Optional[str] = _map_option("subsample", "NAME", "maxmin | knn | probabilistic (default maxmin)."),
     landmarks: Optional[str] = _map_option(
-        "landmarks", "L", "Number of landmarks L per region and window, 3..2000 (default: the fewest that meet the "
-                          "sampling guarantee, at most 400; persistence time grows about as L^3)."),
+        "landmarks", "L", "Number of landmarks L of the map, 3..2000, shared between its regions in proportion to "
+                          "their events and used in every window (default: per window, the fewest that meet the "
+                          "sampling guarantee, at most --max-landmarks; persistence time grows about as L^3)."),
     window: Optional[str] = _map_option("window", "T0:T1", "Time window in seconds (either end may be empty)."),
     maxdim: Optional[str] = _map_option("maxdim", "N", "Highest homology dimension, 1 or 2 (default 1)."),
     seed: Optional[str] = _map_option("seed", "SEED", "Seed of the landmark start and the MDS (default 0)."),
@@ -758,7 +759,7 @@ def _run_map(log, config, log_dir: Path, out_dir: Path, quiet: bool, verbose: bo
     and a broken ground-truth file costs a warning, never the map.  ``ground_truth``
     (arena, truth, trajectories): the caller's, instead of reading them beside the log."""
     from .pipeline import STAGES, map_encounters
-    from .viz.report import write_map_outputs
+    from .viz.report import write_map
 
     with _progress("mapping", quiet) as tick:
         try:
@@ -772,7 +773,7 @@ def _run_map(log, config, log_dir: Path, out_dir: Path, quiet: bool, verbose: bo
     if verbose:
         _map_details(tmap)
     arena, truth, trajectories = ground_truth or _ground_truth(log, log_dir, quiet)
-    return tmap, write_map_outputs(tmap, out_dir, log=log, truth=truth, arena=arena, trajectories=trajectories)
+    return tmap, write_map(tmap, out_dir, log=log, truth=truth, arena=arena, trajectories=trajectories)
 
 
 def _map_details(tmap) -> None:

@@ -58,7 +58,7 @@ REPORTING_PER_CELL = 30
 QUICK_PER_CELL = 10
 SLICE_PER_CELL = 2
 """The regression slice: the first SLICE_PER_CELL reporting cases of every cell
-(default pipeline), rerun by tests/test_accuracy.py against the rate recorded here."""
+(default pipeline), rerun by benchmarks/bench_accuracy_slice.py against the rate recorded here."""
 TUNING_PER_CELL = 96
 
 PIPELINES: dict[str, dict[str, Any]] = {
@@ -496,7 +496,7 @@ def markdown(summary: dict[str, Any], command: str) -> str:
     in_slice = [r for r in summary["records"] if r["index"] < SLICE_PER_CELL]
     if len(in_slice) == SLICE_PER_CELL * len(summary["pipelines"]["default"]["table"]["cells"]):
         lines += ["", f"Regression slice: {sum(r['right'] for r in in_slice)}/{len(in_slice)} exact (the first "
-                      f"{SLICE_PER_CELL} reporting cases of every cell, default pipeline; tests/test_accuracy.py "
+                      f"{SLICE_PER_CELL} reporting cases of every cell, default pipeline; benchmarks/bench_accuracy_slice.py "
                       "reruns them and fails below the 1 % binomial quantile of this rate, Laplace-smoothed)."]
     if summary.get("planning"):
         lines += ["", f"Planning grid ({len(summary['planning'])} maps, default pipeline, 0-3 holes, scales "

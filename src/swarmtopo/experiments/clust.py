@@ -26,6 +26,7 @@ from ..topology.persistence import Diagram
 from .grid import expand_grid
 from .store import read_jobs
 from .sweep import build_arena, run_sweep
+from .reproduction import output_folder, write_reproduction
 from .training import Examples, examples_from_rows, fit_and_select
 
 SCALES = (0.75, 0.9, 1.0, 1.1, 1.25)
@@ -53,7 +54,6 @@ def clust_sweeps(runs: int = RUNS) -> dict[str, Any]:
 def reproduce_clust(out: Path, *, runs: int | None = None, progress: Callable[[int, int, int], None] | None = None,
                     store: Path | None = None, workers: int | None = None, scheduler: str | None = None):
     """Run the sweeps, fit, test, and write ``clust.csv`` and the figures into ``out``."""
-    from .reproduce import output_folder, write_reproduction
     from ..viz.plots import plot_arena, plot_diagram, new_figure, plot_ratio_density, plot_scores_by
 
     runs = RUNS if runs is None else positive_int("runs", runs)

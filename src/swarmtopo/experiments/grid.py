@@ -171,7 +171,7 @@ def _option(name: str) -> Callable[[Any], Any]:
         try:
             return OPTIONS[name].canonical(value)
         except ConfigError as exc:
-            raise _Bad(f"expected {exc.expected}") from None
+            raise _Bad(f"expected {exc.expected}".replace("'", '"')) from None  # TOML's quotes
     return check
 
 

@@ -26,7 +26,7 @@ square hole (:func:`swarmtopo.arena.default_arena`), 200 agents in it (the same 
 of agents per mm^2 of free space elsewhere), the paper's motion parameters, r_d = 30 mm,
 dt = 0.1 s, the paper's pipeline (no per-hop cost, the whole log at once, the paper's
 classifier form trained our way: the ``paper`` preset) and the pipeline's
-defaults for everything else (maxmin, the automatic landmark count capped at 1000,
+defaults for everything else (maxmin, the automatic landmark count capped at 400,
 landmark and MDS seed 0).
 
 Seeds: run i of experiment NAME simulates with :func:`run_seed` (NAME, i), so a run
@@ -36,9 +36,8 @@ its seed (``simulate(arena, agents, duration, rng=seed)`` reruns it).
 
 from __future__ import annotations
 
-import csv
 import zlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 from typing import Any, Callable
@@ -53,7 +52,6 @@ from ..topology.cycles import event_positions
 from ..topology.embed import mds
 from ..errors import InputError, SwarmtopoError
 from ..metric.graph import build_graph
-from .._json import jsonable, write_json
 from ..metric.landmarks import knn_maxmin, maxmin, probabilistic_maxmin
 from ..topology.persistence import Diagram, rips_persistence, snr
 from ..pipeline import MapConfig, TopologicalMap, map_encounters
@@ -61,6 +59,7 @@ from ..pipeline.config import WHOLE_LOG
 from ..pipeline.result import software_versions
 from ..sim import simulate
 from .clust import reproduce_clust
+from .reproduction import Reproduction, output_folder, write_reproduction
 
 PAPER_CLASSIFIER = "paper"
 """The reproductions read Betti numbers with the paper's classifier form, trained our way."""
@@ -99,34 +98,6 @@ SAME_TIME_S = 5.0
 """Pair classes of the ground-truth checks: same place = true positions at most
 SAME_PLACE_MM apart, far = at least FAR_MM apart, same time = at most SAME_TIME_S apart,
 long gap = at least LONG_GAP_S apart (:func:`cylinder_checks`, :func:`metric_diagnostics`)."""
-
-
-@dataclass(frozen=True)
-class Reproduction:
-    """What one reproduced experiment wrote and found.
-
-    Attributes
-    ----------
-    name
-        Experiment name (a key of :data:`REPRODUCTIONS`).
-    figures
-        PNG files written.
-    table
-        The CSV file of results.
-    table_markdown
-        The summary table in Markdown.
-    summary
-        Headline numbers (JSON-able).
-    settings
-        Everything the numbers depend on (JSON-able).
-    """
-
-    name: str
-    figures: list[Path]
-    table: Path
-    table_markdown: str
-    summary: dict[str, Any]
-    settings: dict[str, Any] = field(default_factory=dict)
 
 
 def run_seed(name: str, index: int) -> int:
@@ -516,16 +487,6 @@ class _Ticker:
             self.progress(self.done, self.total, self.failed)
 
 
-def output_folder(out) -> Path:
-    """``out`` as a Path, created (one-line SwarmtopoError if it cannot be)."""
-    out = Path(out)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise SwarmtopoError(f"cannot create the output folder {str(out)!r}: {exc.strerror or exc}") from None
-    return out
-
-
 def _runs(name: str, runs: int | None) -> int:
     return DEFAULT_RUNS[name] if runs is None else positive_int("runs", runs)
 
@@ -608,34 +569,6 @@ def _fmt(value) -> str:
 
 def _rate(agg: dict[str, Any]) -> str:
     return f"{agg['beta1_is_1']}/{agg['runs']}"
-
-
-def _markdown(headers: list[str], cells: list[list]) -> str:
-    lines = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
-    lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in cells]
-    return "\n".join(lines) + "\n"
-
-
-def _write_csv(path: Path, rows: list[dict[str, Any]]) -> Path:
-    """One row per run; floats written in full (``repr``), None as empty."""
-    columns = list(dict.fromkeys(k for row in rows for k in row))
-    with open(path, "w", newline="", encoding="utf-8") as fh:
-        writer = csv.DictWriter(fh, fieldnames=columns)
-        writer.writeheader()
-        for row in rows:
-            writer.writerow({k: "" if row.get(k) is None else row[k] for k in columns})
-    return path
-
-
-def write_reproduction(name, out, rows, headers, cells, figures, summary, settings) -> Reproduction:
-    """Write NAME.csv (``rows``), NAME.md (``headers`` x ``cells``) and NAME.json
-    (summary and settings) into ``out``; the :class:`Reproduction` of them."""
-    table = _write_csv(out / f"{name}.csv", rows)
-    markdown = _markdown(headers, cells)
-    (out / f"{name}.md").write_text(markdown, encoding="utf-8")
-    write_json(jsonable({"name": name, "summary": summary, "settings": settings}), out / f"{name}.json")
-    return Reproduction(name=name, figures=figures, table=table, table_markdown=markdown,
-                        summary=jsonable(summary), settings=jsonable(settings))
 
 
 # -- figures ----------------------------------------------------------------------------

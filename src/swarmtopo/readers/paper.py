@@ -74,20 +74,6 @@ UNBOUNDED_WIDTH = 2.0
 then placed UNBOUNDED_WIDTH / 2 e-folds beyond the extreme ratio."""
 
 
-@dataclass(frozen=True)
-class RegionScales:
-    """Scales of one region's event cloud, in the metric's unit (seconds).
-
-    knn
-        s: median over distinct events of the mean distance to their k nearest others.
-    cover_radius
-        r_cover of the landmark set.
-    """
-
-    knn: float
-    cover_radius: float
-
-
 def bar_lengths(diagram: Diagram, dim: int) -> np.ndarray:
     """|l^i_n| of dgm_dim (decreasing; inf for infinite bars); empty if dim > maxdim."""
     return diagram.lengths(dim) if dim <= diagram.maxdim else np.empty(0)
@@ -562,14 +548,3 @@ def _truth_matrix(y, m: int, dims: list[int]) -> np.ndarray:
     if (truth < 0).any():
         raise SwarmtopoError("true Betti numbers must be >= 0")
     return truth
-
-
-# Transitional re-export for callers that import load_classifier from this module (cli.py,
-# lab scripts, tests): the registry imports this module, so it is imported last and looked
-# up when called.
-from . import registry as _registry  # noqa: E402
-
-
-def load_classifier(name):
-    """:func:`swarmtopo.readers.registry.load_classifier` (its transitional name here)."""
-    return _registry.load_classifier(name)

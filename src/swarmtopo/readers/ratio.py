@@ -82,7 +82,6 @@ from .._json import read_json, write_json
 from .._validate import check_format
 from ..errors import InputError, SwarmtopoError
 from ..topology.persistence import Diagram
-from .base import longest_bars  # noqa: F401 (re-exported)
 from .base import WindowReader, median_vote, product_confidence, vote
 
 RATIO_FORMAT = "swarmtopo-ratio-classifier/5"
@@ -192,14 +191,6 @@ def calibrated_probability(model: dict[str, float], features: dict[str, float]) 
     return float(expit(model["intercept"] + sum(coef * features[name] for name, coef in weighed.items())))
 
 
-def map_confidence(classifier, confidences: Sequence[float | None], n: int = 1) -> float | None:
-    """P(a map's beta_n is right) from its regions' ``confidences``: ``classifier``'s
-    :meth:`RatioClassifier.map_confidence`, the plain product for classifiers of other kinds."""
-    if isinstance(classifier, RatioClassifier):
-        return classifier.map_confidence(confidences, n)
-    return product_confidence(confidences)
-
-
 def confidence_model() -> LogisticRegression:
     """The (unfitted) logistic model :meth:`RatioClassifier.calibrate` fits on :func:`confidence_design`."""
     return LogisticRegression(C=1.0)
@@ -255,12 +246,6 @@ def score_margin(scores: np.ndarray, tau: float) -> float:
     if count < len(scores):
         sides.append(np.log(tau) - scores[count])
     return float(min([MAX_MARGIN, *sides]))
-
-
-def region_reader(classifier, windows: Sequence[Diagram], agreement) -> Any:
-    """How ``classifier`` reads one region: itself (``windows`` and ``agreement`` are not
-    read; kept for callers that pass them)."""
-    return classifier
 
 
 def grid_estimates(maps: Sequence[Sequence[Sequence[Diagram]]], pooling: str = "mean",

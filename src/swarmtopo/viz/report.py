@@ -18,10 +18,10 @@ from .summary import map_json
 from .report_html import write_report
 
 MAP_FILES = ("map.json", "report.html", "diagram.png", "cloud.png")
-"""Every file :func:`write_map_outputs` may write: a map's output folder holds these."""
+"""Every file :func:`write_map` may write: a map's output folder holds these."""
 
 
-def write_map_outputs(tmap: TopologicalMap, out_dir: Path, *, log: EncounterLog,
+def write_map(tmap: TopologicalMap, out_dir: Path, *, log: EncounterLog,
                       truth: dict[str, np.ndarray] | None = None, arena=None,
                       trajectories: dict[str, np.ndarray] | None = None) -> list[Path]:
     """Write map.json, report.html, diagram.png and (with an MDS picture) cloud.png; return the paths.

@@ -15,6 +15,7 @@ from .._json import jsonable
 from ..pipeline.result import RegionMap, TopologicalMap, WindowMap
 from ..readers.beta0 import BETA0_DEFINITION
 from ..readers.ratio import RESOLUTION_CAP, below_full_resolution, resolution
+from .text import format_confidence
 
 ADVICE_BELOW = 0.9
 """A Betti number reported with less confidence than this comes with advice."""
@@ -25,7 +26,8 @@ def advice(tmap: TopologicalMap) -> list[str]:
     low = [n for n, p in sorted(tmap.confidence.items()) if p is not None and p < ADVICE_BELOW]
     if not low:
         return []
-    lines = [f"beta_{n} = {tmap.betti[n]} is uncertain ({100 * tmap.confidence[n]:.0f}% confidence)" for n in low]
+    lines = [f"beta_{n} = {tmap.betti[n]} is uncertain ({format_confidence(tmap.confidence[n])} confidence)"
+             for n in low]
     evidence = tmap.beta0_evidence
     if 0 in low and evidence is not None:
         apart = (f"have stayed apart for only {evidence.settled:.3g} mean gaps between an agent's encounters since "

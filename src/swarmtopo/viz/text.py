@@ -1,5 +1,5 @@
-"""Numbers as swarmtopo prints them, the same on the command line, in report.html and
-in figures."""
+"""Numbers as swarmtopo prints them, the same on the command line, in map.json's advice
+and in report.html."""
 
 from __future__ import annotations
 
