@@ -452,7 +452,7 @@ def test_version():
     assert proc.returncode == 0 and proc.stdout == f"swarmtopo {version('swarmtopo')}\n" and proc.stderr == ""
 
 
-@pytest.mark.parametrize("command", [(), ("simulate",), ("ingest",), ("demo",), ("sweep",), ("reproduce",),
+@pytest.mark.parametrize("command", [(), ("simulate",), ("ingest",), ("map",), ("demo",), ("sweep",), ("reproduce",),
                                      ("plan",), ("bench",), ("bench", "accuracy")])
 def test_help_sends_nobody_to_files_they_do_not_have(command):
     """A pip install has no docs/ folder: a pointer to one says it is in the source repository."""
