@@ -222,7 +222,7 @@ def test_keys_are_the_same_in_another_process():
     ("[map]\nwindow_encounters = 0", ["[map] window_encounters = 0", "> 0"]),
     ("[map]\nwindow_length = 'none'\nwindow_step = 5", ["[map] window_step", 'window_length is "none"']),
     ("[map]\nwindow_length = 'none'\nwindow_scales = [1, 2]", ["[map] window_scales", 'window_length is "none"']),
-    ("[map]\nwindow_scales = [1, 0]", ["[map] window_scales = [1, 0]", "positive number"]),
+    ("[map]\nwindow_scales = [1, 0]", ["[map] window_scales = [1, 0]", "each a finite number >= 0.05"]),
     ("[map]\nwindow_scales = []", ["[map] window_scales = []", "positive number"]),
     ("[map]\nclassifier = 'nope.json'", ['[map] classifier = "nope.json"', "cannot read"]),
     ("[arena]\nholes = []", ["[arena] holes = []", "empty list"]),

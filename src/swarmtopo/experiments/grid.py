@@ -154,15 +154,12 @@ def _shape_set(value) -> tuple[str, ...]:
 
 
 def _scale_set(value) -> tuple[float, ...]:
+    """A set of window scales: a number or a list of them, canonical sorted and distinct,
+    each checked by the map's own option parser."""
     scales = value if isinstance(value, list) else [value]
-    number = _number(0.0, strict=True)
-    try:
-        checked = [number(v) for v in scales]
-    except _Bad:
-        raise _Bad("expected a positive number or a list of them") from None
-    if not checked:
+    if not scales or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in scales):
         raise _Bad("expected a positive number or a list of them")
-    return tuple(sorted(set(checked)))
+    return tuple(sorted(_option("window_scales")(sorted(set(scales)))))
 
 
 def _option(name: str) -> Callable[[Any], Any]:

@@ -301,9 +301,9 @@ def _numbers(item: Callable[[Any], float], example: str) -> Callable[[Any], tupl
         try:
             numbers = tuple(item(x) for x in items)
         except ValueError as exc:
-            raise ValueError(f"a comma-separated list of distinct numbers, each {exc} (e.g. {example})") from None
+            raise ValueError(f"a list of distinct numbers, each {exc} (e.g. {example})") from None
         if not numbers or len(set(numbers)) < len(numbers):
-            raise ValueError(f"a comma-separated list of distinct numbers (e.g. {example})")
+            raise ValueError(f"a list of distinct numbers (e.g. {example})")
         return numbers
     return parse
 
