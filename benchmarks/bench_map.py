@@ -41,7 +41,7 @@ from bench_landmarks import compare_with_dense
 from swarmtopo.metric.graph import build_graph
 from swarmtopo.metric.landmarks import SUBSAMPLERS
 from swarmtopo.pipeline import MapConfig, map_encounters
-from swarmtopo.pipeline.map import max_windows_option
+from swarmtopo.pipeline.config import config_from_options
 
 N_LANDMARKS = 500
 METRICS = ("plain", "hybrid")
@@ -108,7 +108,7 @@ def main():
                         help=f"cap of the windows mapped in part 1 (default {MapConfig.max_windows}, the pipeline's; "
                              "'none': every window)")
     args = parser.parse_args()
-    max_windows = max_windows_option(args.max_windows)
+    max_windows = config_from_options({"max_windows": args.max_windows}).max_windows
     print(f"machine: {machine()}; {numba.get_num_threads()} numba threads; swarmtopo {revision()}")
     warm_up()
     whole_map(10**5 if args.quick else 10**6, args.subsample, max_windows)

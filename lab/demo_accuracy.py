@@ -37,7 +37,7 @@ def main() -> None:
         for label, (options, classifier) in PIPELINES.items():
             model = load_classifier(classifier)
             right = [sum(map_encounters(log, MapConfig(seed=seed, embed_dim=0, cycles=False, **options),
-                                        classifier=model).betti[1] == holes
+                                        reader=model).betti[1] == holes
                          for seed, log in enumerate(logs[t])) for t in (20.0, 30.0)]
             print(f"| {name} | {label} | {right[0]}/{args.seeds} | {right[1]}/{args.seeds} |")
 

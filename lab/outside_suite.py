@@ -132,7 +132,7 @@ def _run(task):
     margins = {}
     try:
         tmap = map_encounters(log, MapConfig(seed=seed % 2**32, embed_dim=0, cycles=False, **options),
-                              classifier=None if classifier is None else cached_classifier(classifier, classifier))
+                              reader=None if classifier is None else cached_classifier(classifier, classifier))
         mapped, confidence = (tmap.betti[0], tmap.betti[1]), tmap.confidence[1]
         margins = band_margins(tmap, arena.betti[1]) if band_scores else {}
     except SwarmtopoError as error:  # a log the pipeline refuses is a wrong map, with its reason

@@ -422,6 +422,8 @@ def test_map_paper_and_pipeline_options(simulated, tmp_path):
         (("map", log, "--max-windows", "2"), ("'--max-windows': must be a whole number, at least the number of "
                                                "window scales (3: one window per length), or 'none'; got 2",), 2),
         (("map", log, "--paper", "--max-windows", "5"), ("--paper fixes --max-windows",), 2),
+        (("map", log, "--paper", "--window-step", "3"), ("--paper fixes --window-step",), 2),
+        (("map", log, "--paper", "--window-encounters", "5"), ("--paper fixes --window-encounters",), 2),
         (("map", log, "--landmark-bands", "1,1.5"), ("each a finite number > 0 and <= 1",), 2),
         (("map", log, "--landmark-bands", "0.5,x"), ("a list of distinct numbers, each",), 2),
         (("map", log, "--landmark-bands", "0.5,0.5"), ("list of distinct numbers",), 2),

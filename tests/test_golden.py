@@ -70,3 +70,31 @@ def test_rounding_keeps_ten_significant_digits_and_every_other_value():
     assert rounded(doc) == {"a": [0.3, 1e-300, None, "x", 3, True], "b": {"c": 123456789000.0}}
     assert map_digest({"betti": 1, "timings": {"graph": 1.0}}) == map_digest({"betti": 1, "software": {}})
     assert map_digest({"betti": 1}) != map_digest({"betti": 2})
+
+
+READINGS = {
+    "paper": ({"0": 1, "1": 1}, "e68ba73504735377f883ab520f89d4138930512ddbee796265e8d374adf55117"),
+    "trace": ({"0": 1, "1": 1}, "ed4be6fd990da2fe4ca5f089f1a9a1c4a9ce0b22a791bb368ec2b8bba25e1ec3"),
+}
+"""Reading -> (Betti numbers, :func:`map_digest`) of the ``one_hole`` log mapped as a
+contact trace (its events.csv alone: the ``trace`` reader) and with ``--paper`` (the
+paper's pipeline and its ``paper`` reader)."""
+
+
+@pytest.mark.parametrize("reading", sorted(READINGS))
+def test_golden_readings_of_the_one_hole_log_are_unchanged(reading, one_hole_log, tmp_path, cli):
+    import shutil
+
+    if reading == "trace":
+        folder = tmp_path / "trace"
+        folder.mkdir()
+        shutil.copy(one_hole_log.folder / "events.csv", folder / "events.csv")
+        args = ()
+    else:
+        folder, args = one_hole_log.folder, ("--paper",)
+    proc = cli("map", folder, "--out", tmp_path / "map", "-q", *args)
+    assert proc.returncode == 0, proc.stderr
+    doc = json.loads((tmp_path / "map" / "map.json").read_text(encoding="utf-8"))
+    assert doc["classifier"]["classifier"] == reading
+    got = (doc["betti"], map_digest(doc))
+    assert got == READINGS[reading], f"the {reading} reading changed; if intended, paste into READINGS:\n    {reading!r}: {got!r},"

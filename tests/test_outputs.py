@@ -225,3 +225,53 @@ def test_a_log_writer_failing_midway_keeps_the_previous_log(tmp_path, monkeypatc
                               "--overwrite")
     assert (code, out, err) == (1, "", f"error: {folder / 'events.csv'}: No space left on device\n")  # not the staged
     assert snapshot(folder) == before and hidden(folder) == []
+
+
+def test_an_entry_the_command_did_not_write_is_never_replaced(tmp_path):
+    """A user's folder where the command writes a file, or a file where it keeps a
+    folder: refused, naming it, and nothing moves."""
+    (tmp_path / "events.csv").mkdir()
+    (tmp_path / "events.csv" / "inner.txt").write_text("mine")
+    with pytest.raises(SwarmtopoError, match=r"events.csv: a folder swarmtopo did not write"):
+        with staged_folder(tmp_path, [], what="log", overwrite=True) as stage:
+            (stage.path / "events.csv").write_text("t,a,b\n")
+    assert (tmp_path / "events.csv" / "inner.txt").read_text() == "mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["events.csv"]  # no staging folder left
+    (tmp_path / "log").write_text("precious")
+    with pytest.raises(SwarmtopoError, match=r"log: is a file where the demo keeps a folder"):
+        with staged_folder(tmp_path, {"log": ["events.csv"]}, what="demo", overwrite=True):
+            pass
+    assert (tmp_path / "log").read_text() == "precious"
+
+
+def test_map_of_a_file_says_it_is_not_a_log_folder(tmp_path, cli):
+    (tmp_path / "events.csv").write_text("t,a,b\n0,1,2\n")
+    proc = cli("map", tmp_path / "events.csv")
+    assert proc.returncode == 1 and proc.stderr.count("\n") == 1, proc.stderr
+    assert "is a file, not a log folder" in proc.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["events.csv"]
+
+
+def test_a_real_sigint_during_a_re_map_keeps_the_previous_map(tmp_path, one_hole_log):
+    """Ctrl-C as a terminal sends it, to a real process: one line, exit 130, the previous
+    map byte for byte, no staging folder left (whenever during the run it arrives)."""
+    import shutil
+    import signal
+    import subprocess
+    import time
+
+    log = tmp_path / "log"
+    shutil.copytree(one_hole_log.folder, log)
+    out = log / "map"
+    previous = previous_map(out)
+    for delay in (1.0, 3.0):  # during start-up and reading, and during the map
+        proc = subprocess.Popen([sys.executable, "-m", "swarmtopo", "map", str(log), "--overwrite"],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        time.sleep(delay)
+        proc.send_signal(signal.SIGINT)
+        stdout, stderr = proc.communicate(timeout=120)
+        if proc.returncode == 0:  # the map finished first: nothing to interrupt on this machine
+            continue
+        assert proc.returncode == 130, stderr
+        assert len(stderr.strip().splitlines()) == 1 and stderr.startswith("interrupted: nothing written"), stderr
+        assert snapshot(out) == previous and hidden(out) == []

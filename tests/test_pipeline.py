@@ -168,9 +168,13 @@ def test_window_restricts_events():
 @pytest.mark.parametrize("bad, match", [
     (dict(metric="euclid"), "unknown metric"),
     (dict(subsample="random"), "unknown subsampler"),
-    (dict(landmarks=2), r"landmarks: must be in 3\.\.2000"),
-    (dict(landmarks=2001), r"landmarks: must be in 3\.\.2000"),
-    (dict(max_landmarks=2001), r"max_landmarks: must be in 3\.\.2000"),
+    (dict(landmarks=2), r"landmarks: must be a whole number in 3\.\.2000"),
+    (dict(landmarks=10.5), r"landmarks: must be a whole number"),
+    (dict(seed=-3), "seed: must be a whole number >= 0"),
+    (dict(seed=1.5), "seed: must be a whole number >= 0"),
+    (dict(window_scales=(0.01,)), "window_scales: must be one or more numbers >= 0.05"),
+    (dict(landmarks=2001), r"landmarks: must be a whole number in 3\.\.2000"),
+    (dict(max_landmarks=2001), r"max_landmarks: must be a whole number in 3\.\.2000"),
     (dict(maxdim=3), "maxdim"),
     (dict(window=(5.0, 1.0)), "before its start"),
     (dict(hop_cost=-1.0), "hop_cost"),
@@ -423,8 +427,8 @@ def test_bad_landmark_bands_are_refused(bands, subsample, message):
         MapConfig(landmark_bands=bands, subsample=subsample).validate()
 
 
-@pytest.mark.parametrize("scales, message", [((), "one or more positive"), ((1.0, 0.0), "one or more positive"),
-                                             ((1.0, float("nan")), "one or more positive"),
+@pytest.mark.parametrize("scales, message", [((), "one or more numbers >= 0.05"), ((1.0, 0.0), "one or more numbers >= 0.05"),
+                                             ((1.0, float("nan")), "one or more numbers >= 0.05"),
                                              ((1.0, 1.0), "distinct")])
 def test_bad_window_scales_are_refused(scales, message):
     with pytest.raises(SwarmtopoError, match=message):

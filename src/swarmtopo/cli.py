@@ -386,9 +386,9 @@ def map_command(
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
     """Map an encounter log folder: Betti numbers with confidence, diagrams and pictures."""
-    from .io.logs import read_log
+    from .io.logs import log_folder, read_log
     from .log import exact_time
-    from .pipeline.config import PAPER_OPTIONS, ConfigError, config_from_options
+    from .pipeline.config import PAPER_EXCLUDES, PAPER_OPTIONS, ConfigError, config_from_options
     from .readers.registry import load_classifier
     from .viz.report import MAP_FILES
 
@@ -399,8 +399,7 @@ def map_command(
                "window_encounters": window_encounters, "window_scales": window_scales, "window_step": window_step,
                "max_windows": max_windows, "landmark_bands": landmark_bands, "max_landmarks": max_landmarks}
     if paper:
-        # the whole log at once: a window cap has nothing to cap
-        given = [_option_name(name) for name in (*PAPER_OPTIONS, "max_windows") if options[name] is not None]
+        given = [_option_name(name) for name in PAPER_EXCLUDES if options[name] is not None]
         if given or classifier is not None:
             raise typer.BadParameter(f"--paper fixes {', '.join(given + ['--classifier'] * (classifier is not None))}; "
                                      "drop one or the other")
@@ -414,6 +413,7 @@ def map_command(
         reason = re.sub(r"\bNone\b", "'none'", exc.reason)
         raise typer.BadParameter(reason, param_hint=f"'{_option_name(exc.field)}'") from None
     model = load_classifier(classifier) if classifier else None  # None: the shipped one for the log
+    log_folder(log_dir)  # a file or a missing folder is said as such, before any output is staged
     with output.staged_folder(out_dir, MAP_FILES, what="map", overwrite=overwrite) as stage:
         log = read_log(log_dir)
         if verbose:
@@ -838,9 +838,12 @@ def _warn(message: str, quiet: bool) -> None:
 
 
 def _print_verdict(tmap, truth) -> None:
+    """The map's answer, one line per fact (never wrapped, even in a pipe)."""
     from .viz.summary import advice
-
     from .viz.text import format_confidence
+
+    def say(text: str) -> None:
+        out.print(text, markup=False, highlight=False, soft_wrap=True)
 
     def confidence(n):
         p = tmap.confidence.get(n)
@@ -849,16 +852,16 @@ def _print_verdict(tmap, truth) -> None:
     est = ", ".join(f"beta_{n} = {b}{confidence(n)}" if b is not None else
                     f"beta_{n} not estimated (the classifier has no threshold for it)"
                     for n, b in sorted(tmap.betti.items()))
-    out.print(f"recovered: {est}")
+    say(f"recovered: {est}")
     if truth is not None:
-        out.print(f"true:      beta_0 = {truth[0]}, beta_1 = {truth[1]}")
+        say(f"true:      beta_0 = {truth[0]}, beta_1 = {truth[1]}")
     for warning in tmap.warnings:
-        out.print(f"warning: {warning}", markup=False)
+        say(f"warning: {warning}")
     for line in advice(tmap):
-        out.print(f"advice: {line}", markup=False, highlight=False, soft_wrap=True)
+        say(f"advice: {line}")
     for small in tmap.too_little_data:
-        out.print(f"note: {small['events']} encounter(s) of {small['agents']} agent(s) never linked to the "
-                  "rest: too little data, not counted as a region")
+        say(f"note: {small['events']} encounter(s) of {small['agents']} agent(s) never linked to the rest: too little "
+            "data, not counted as a region")
 
 
 def main() -> None:

@@ -9,7 +9,7 @@ map are examples; a map whose largest region is one of several is still an examp
 both on held-out maps (never on the training F), keeps the better one (lower held-out
 F; the grid optimizer on a tie, being exact and deterministic) and calibrates its
 confidence on the held-out maps.  ``lab/train_classifier.py`` runs it on
-:data:`DEFAULT_TRAINING` to make the shipped ``classifier-default.json``.
+:data:`DEFAULT_TRAINING` to make the shipped ``classifier-paper.json``.
 """
 
 from __future__ import annotations

@@ -78,7 +78,7 @@ TRUTH_COLUMNS = ("t", "a", "b", "xa", "ya", "xb", "yb")
 TRAJECTORY_COLUMNS = ("t", "agent", "x", "y")
 GROUND_TRUTH_FILES = ("arena.geojson",
                       *(f"{stem}{suffix}" for stem in ("truth", "trajectories") for suffix in TABLE_SUFFIXES))
-"""Files that only a simulator can write; ``swarmtopo map`` never reads them."""
+"""Files that only a simulator can write; ``swarmtopo map`` reads them for pictures only, never to estimate."""
 
 _TABLE_STEMS = ("events", "status", "truth", "trajectories")
 _ID_COLUMNS = ("a", "b", "agent")
@@ -192,7 +192,7 @@ def read_log(directory) -> EncounterLog:
         text that is not UTF-8, malformed ``meta.json`` or another ``format``; or when
         two versions of one table exist (``events.csv`` and ``events.parquet``).
     """
-    directory = _log_dir(directory)
+    directory = log_folder(directory)
     meta_path = directory / "meta.json"
     meta = _read_meta(meta_path)
     events_path = _find_table(directory, "events", required=True)
@@ -286,7 +286,7 @@ def read_trajectories(directory) -> dict[str, np.ndarray] | None:
 def _read_ground_truth(directory, name: str, columns, id_names, position_columns):
     """(path, table, arrays) of the ground-truth table ``name.<fmt>``, or None if absent:
     ``t`` and the positions as float64, the ID columns as the log reads IDs."""
-    directory = _log_dir(directory)
+    directory = log_folder(directory)
     path = _find_table(directory, name)
     if path is None:
         return None
@@ -313,7 +313,7 @@ def strip_ground_truth(src_dir, dst_dir) -> None:
     file outside the contract.  Used to prove that ``swarmtopo map`` needs nothing else.
     ``dst_dir`` must not exist yet or be empty.
     """
-    src, dst = _log_dir(src_dir), Path(dst_dir)
+    src, dst = log_folder(src_dir), Path(dst_dir)
     if dst.exists() and (not dst.is_dir() or any(dst.iterdir())):
         raise InputError("destination must be a new or empty folder", file=str(dst))
     make_folder(dst)
@@ -406,7 +406,9 @@ def _json_id(value):
 
 
 # -- reading helpers -----------------------------------------------------------------------
-def _log_dir(directory) -> Path:
+def log_folder(directory) -> Path:
+    """``directory`` as a Path if it is a folder; a one-line InputError naming it if it is
+    a file or missing."""
     directory = Path(directory)
     if not directory.is_dir():
         raise InputError("is a file, not a log folder" if directory.exists() else "log folder not found",

@@ -110,6 +110,10 @@ def staged_folder(final, owned: Owned | Iterable[str], *, what: str, overwrite: 
     target = final.resolve()  # a symlinked folder is written where it points
     if target.exists() and not target.is_dir():
         raise SwarmtopoError(f"{final}: is a file; give a folder for the {what}")
+    for name, inner in owned.items():  # an owned folder the user replaced by a file: never overwritten
+        if inner is not None and (target / name).exists() and not (target / name).is_dir():
+            raise SwarmtopoError(f"{final / name}: is a file where the {what} keeps a folder; move it away, or "
+                                 "choose another --out")
     previous = sorted(name for name in owned if (target / name).exists())
     if previous and not overwrite:
         raise SwarmtopoError(f"{final}: already holds a {what} ({', '.join(previous)}); pass --overwrite to "
@@ -133,7 +137,7 @@ def staged_folder(final, owned: Owned | Iterable[str], *, what: str, overwrite: 
                     target.parent.mkdir(parents=True, exist_ok=True)
                     os.rename(stage.path, target)
                 else:
-                    stage.removed = [final / p for p in _switch(stage.path, target, owned)]
+                    stage.removed = [final / p for p in _switch(stage.path, target, owned, what)]
             except OSError as exc:
                 raise InputError(f"cannot move the new {what} into place ({exc.strerror or exc})",
                                  file=str(final)) from None
@@ -171,9 +175,11 @@ def _new_folder(parent: Path, stem: str, final: Path) -> Path:
         raise InputError(f"cannot create the output folder ({exc.strerror or exc})", file=str(final)) from None
 
 
-def _switch(staged: Path, final: Path, owned: dict) -> list[str]:
+def _switch(staged: Path, final: Path, owned: dict, what: str) -> list[str]:
     """Replace ``final``'s owned entries by ``staged``'s (then empty); return the owned
-    entries deleted without a replacement, relative to ``final``.  A failed rename undoes
+    entries deleted without a replacement, relative to ``final``.  An entry the command
+    does not own, or of another kind (a folder where it writes a file), is never
+    replaced: a SwarmtopoError names it before anything moves.  A failed rename undoes
     the renames before it."""
     aside = _new_folder(final, ".swarmtopo-old", final)
     moves: list[tuple[Path, Path]] = []
@@ -186,6 +192,10 @@ def _switch(staged: Path, final: Path, owned: dict) -> list[str]:
         for entry in sorted(old.iterdir()):
             if entry in (staged, aside) or entry.name in merged:
                 continue
+            if entry.name in incoming and (entry.name not in owned or entry.is_dir() != (new / entry.name).is_dir()):
+                kind = "folder" if entry.is_dir() else "file"
+                raise SwarmtopoError(f"{final / prefix}{entry.name}: a {kind} swarmtopo did not write stands where "
+                                     f"the new {what} puts its own; move it away, or choose another --out")
             if entry.name in owned or entry.name in incoming:
                 moves.append((entry, aside / str(len(moves))))
                 if entry.name not in incoming:

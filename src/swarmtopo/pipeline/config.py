@@ -162,8 +162,11 @@ class MapConfig:
             bad("subsample", f"unknown subsampler {self.subsample!r}; expected one of {', '.join(SUBSAMPLERS)}")
         for name in ("landmarks", "max_landmarks"):
             count = getattr(self, name)
-            if count is not None and not 3 <= count <= MAX_LANDMARKS:
-                bad(name, f"must be in 3..{MAX_LANDMARKS} (persistence time grows about as L^3), got {count}")
+            if count is not None and not (_is_whole(count) and 3 <= count <= MAX_LANDMARKS):
+                bad(name, f"must be a whole number in 3..{MAX_LANDMARKS} (persistence time grows about as L^3), "
+                          f"got {count}")
+        if self.seed is not None and not (_is_whole(self.seed) and self.seed >= 0):
+            bad("seed", f"must be a whole number >= 0 or None, got {self.seed}")
         if self.hop_cost is not None and not (np.isfinite(self.hop_cost) and 0 <= self.hop_cost <= MAX_HOP_COST):
             bad("hop_cost", f"must be a number of seconds in [0, {MAX_HOP_COST:g}], got {self.hop_cost}")
         if self.diffusion_time is not None and not self.diffusion_time > 0:
@@ -177,8 +180,8 @@ class MapConfig:
         if not (np.isfinite(self.window_encounters) and self.window_encounters > 0):
             bad("window_encounters", f"must be a positive number, got {self.window_encounters}")
         scales = self.window_scales
-        if not scales or not all(_is_number(x) and np.isfinite(x) and x > 0 for x in scales):
-            bad("window_scales", f"must be one or more positive numbers, got {list(scales)}")
+        if not scales or not all(_is_number(x) and np.isfinite(x) and x >= MIN_WINDOW_SCALE for x in scales):
+            bad("window_scales", f"must be one or more numbers >= {MIN_WINDOW_SCALE:g}, got {list(scales)}")
         if len(set(scales)) < len(scales):
             bad("window_scales", f"must be distinct, got {list(scales)}")
         bands = (1.0,) if self.landmark_bands is None else self.landmark_bands
@@ -211,7 +214,11 @@ class MapConfig:
 PAPER_OPTIONS = {"hop_cost": 0.0, "diffusion_time": "none", "wall_follow_weight": "none", "window_length": "none",
                  "window_scales": (1.0,), "landmark_bands": (1.0,)}
 """The options of the paper's pipeline (no per-hop cost, no diffusive weights, wall
-following like any time, the whole log), read by the ``paper`` reader."""
+following like any time, the whole log at once, whole-window landmarks), read with the
+``paper`` reader (``swarmtopo map --paper``)."""
+PAPER_EXCLUDES = (*PAPER_OPTIONS, "window_encounters", "window_step", "max_windows")
+"""Options that ``--paper`` fixes, or that mean nothing when the whole log is one window:
+giving one with it is refused."""
 
 
 # -- the one parser of option values ----------------------------------------------------
@@ -243,6 +250,10 @@ class Option:
         """The MapConfig field value of a canonical value."""
         words = self.words or {}
         return words[canonical] if isinstance(canonical, str) and canonical in words else canonical
+
+
+def _is_whole(x) -> bool:
+    return isinstance(x, (int, np.integer)) and not isinstance(x, bool)
 
 
 def _is_number(x) -> bool:
@@ -333,6 +344,7 @@ def _span(value) -> tuple[float | None, float | None]:
 
 def _choice(options) -> Callable[[Any], str]:
     def parse(value) -> str:
+        value = value.strip().lower() if isinstance(value, str) else value
         if value not in options:
             raise ValueError(f"one of {', '.join(options)}")
         return value

@@ -133,7 +133,7 @@ def map_encounters(
         windows_left_out=settings.windows_left_out,
         log_warnings=silence_warnings(settings.times, settings.window_length[0]) + _extrapolation_warnings(betti),
         beta0_evidence=split.beta0,
-        contact_trace=shipped_reader_for(log) == "trace",
+        contact_trace=len(log.status_t) == 0,
         software=software_versions(),
     )
 

@@ -109,7 +109,7 @@ class TopologicalMap:
     software: dict[str, str] = field(default_factory=dict)
     log_warnings: list[str] = field(default_factory=list)  # about the mapped log as a whole
     beta0_evidence: Beta0Evidence | None = None  # what beta_0's confidence was read from
-    contact_trace: bool = False  # the log has no status changes (read as a contact trace)
+    contact_trace: bool = False  # the log has no status changes: a contact trace
 
     @property
     def warnings(self) -> list[str]:

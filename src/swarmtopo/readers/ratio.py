@@ -85,7 +85,7 @@ from ..topology.persistence import Diagram
 from .base import WindowReader, median_vote, product_confidence, vote
 
 RATIO_FORMAT = "swarmtopo-ratio-classifier/5"
-"""The one file format read and written (/5: no agreement gate, calibrations of z)."""
+"""The one file format read and written."""
 POOLINGS = ("mean", "median")
 MAX_MARGIN = 3.0
 """Cap of the log margin (a score e^3 = 20 times off the threshold is as sure as it gets)."""

@@ -42,9 +42,11 @@ def advice(tmap: TopologicalMap) -> list[str]:
         if len(set(counts)) > 1:
             lines.append(f"region {r.component}: its {len(counts)} time windows counted {counts} holes each")
         if 1 in low and below_full_resolution(diagrams := [w.diagram for w in r.windows]):
-            lines.append(f"region {r.component}: its windows tell about {np.exp(resolution(diagrams)):.0f} places "
-                         f"apart (landmarks; {RESOLUTION_CAP} at full resolution): with few places a hole can go "
-                         "unseen in every window alike, so agreeing windows are no proof")
+            places = f"{np.exp(resolution(diagrams)):.0f} places apart (landmarks; {RESOLUTION_CAP} at full resolution)"
+            lines.append(f"region {r.component}: its windows tell about {places}: with few places a hole can go "
+                         "unseen in every window alike, so agreeing windows are no proof" if len(diagrams) > 1 else
+                         f"region {r.component}: its one window tells about {places}: with few places a hole can go "
+                         "unseen")
     length = tmap.window_length[0]
     more_time = ("" if tmap.windows_left_out else
                  f"record longer (each extra {tmap.config.window_step or length / 2:.3g} s adds a window to "
