@@ -58,8 +58,7 @@ import pyarrow.compute as pc
 import pyarrow.csv as pcsv
 import pyarrow.parquet as pq
 
-from .._json import atomic_write as _atomic_write
-from .._json import os_reason as _os_reason
+from .._json import atomic_write, os_reason
 from .._json import read_json, write_json
 from ..arena import Arena
 from ..errors import InputError, SwarmtopoError
@@ -151,7 +150,7 @@ def write_log(
             try:
                 path.unlink()
             except OSError as exc:
-                raise InputError(f"cannot delete an outdated log file ({_os_reason(exc)})", file=str(path)) from None
+                raise InputError(f"cannot delete an outdated log file ({os_reason(exc)})", file=str(path)) from None
     return written
 
 
@@ -320,7 +319,7 @@ def strip_ground_truth(src_dir, dst_dir) -> None:
     for stem in ("events", "status"):
         path = _find_table(src, stem, required=stem == "events")
         if path is not None:
-            _atomic_write(dst / path.name, lambda tmp, path=path: shutil.copyfile(path, tmp))
+            atomic_write(dst / path.name, lambda tmp, path=path: shutil.copyfile(path, tmp))
     if (src / "meta.json").is_file():
         meta = read_json(src / "meta.json")
         if isinstance(meta, dict):
@@ -379,9 +378,9 @@ def _trajectory_columns(trajectories: dict) -> dict:
 def _write_table(columns: dict, path: Path) -> Path:
     table = pa.table({name: _arrow_column(values) for name, values in columns.items()})
     if path.suffix == ".csv":
-        _atomic_write(path, lambda tmp: pcsv.write_csv(table, tmp))
+        atomic_write(path, lambda tmp: pcsv.write_csv(table, tmp))
     else:
-        _atomic_write(path, lambda tmp: pq.write_table(table, tmp))
+        atomic_write(path, lambda tmp: pq.write_table(table, tmp))
     return path
 
 
@@ -397,7 +396,7 @@ def make_folder(directory: Path) -> None:
     try:
         directory.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        reason = "a file of that name exists" if directory.is_file() else _os_reason(exc)
+        reason = "a file of that name exists" if directory.is_file() else os_reason(exc)
         raise InputError(f"cannot create the output folder ({reason})", file=str(directory)) from None
 
 

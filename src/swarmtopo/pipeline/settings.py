@@ -72,15 +72,16 @@ def resolve(log: EncounterLog, config: MapConfig, reader: BettiReader) -> Settin
     bands = config.landmark_bands
     if bands is None:
         bands = reader.landmark_bands if config.subsample == "maxmin" else (1.0,)
-    return Settings(hop_cost=hop_cost(mapped, config.hop_cost),
+    return Settings(hop_cost=hop_cost(mapped, config.hop_cost, gap),
                     diffusion_time=diffusion_time(gap, config.diffusion_time),
                     window_length=length, spans=spans, tried=sorted(x for x in lengths if x < span),
                     windows_left_out=left_out, landmark_bands=tuple(bands), agent_gap=gap, times=times)
 
 
-def hop_cost(log: EncounterLog, given: float | None) -> tuple[float, str]:
+def hop_cost(log: EncounterLog, given: float | None, gap: float | None = None) -> tuple[float, str]:
     """(h, where it came from): the given value, else r_d / v_c from the log's meta.json,
-    else ``HOP_GAP_FACTOR`` x the mean time between an agent's consecutive encounters."""
+    else ``HOP_GAP_FACTOR`` x ``gap``, the mean time between an agent's consecutive
+    encounters (:func:`mean_agent_gap` of ``log`` when not given)."""
     if given is not None:
         return float(given), "given"
     r_d, v_c = log.meta.get("r_d"), log.meta.get("v_c")
@@ -90,7 +91,7 @@ def hop_cost(log: EncounterLog, given: float | None) -> tuple[float, str]:
             raise InputError(f"meta.json: r_d = {r_d:g} and v_c = {v_c:g} give a per-hop cost r_d / v_c of {h:.3g} s, "
                              f"more than {MAX_HOP_COST:g} s (the bound of --hop-cost): r_d must be in mm, v_c in mm/s")
         return h, "r_d / v_c from meta.json"
-    gap = mean_agent_gap(log)
+    gap = mean_agent_gap(log) if gap is None else gap
     if gap is None:
         return 0.0, "no agent met twice at different times: 0"
     return HOP_GAP_FACTOR * gap, f"{HOP_GAP_FACTOR:g} x mean time between an agent's encounters"

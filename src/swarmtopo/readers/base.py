@@ -29,6 +29,7 @@ from typing import Any, Protocol, Sequence, runtime_checkable
 
 import numpy as np
 
+from .._json import read_json, write_json
 from ..errors import SwarmtopoError
 from ..topology.persistence import Diagram
 
@@ -131,9 +132,18 @@ def fitted_bands(provenance: dict) -> tuple[float, ...]:
 
 
 class WindowReader:
-    """:meth:`read` and :attr:`landmark_bands` of a reader with ``betti(diagram)``,
+    """:meth:`read`, :attr:`landmark_bands`, :meth:`save` and :meth:`load` of a reader with ``betti(diagram)``,
     ``pooled_betti(windows)``, ``margin(diagram, n)``, ``region_confidence(windows, voted)``,
-    ``length_thresholds(diagram)`` and ``provenance_`` (module docstring)."""
+    ``length_thresholds(diagram)``, ``provenance_``, ``to_json`` and ``from_json`` (module docstring)."""
+
+    def save(self, path) -> None:
+        """Write the fitted reader as JSON (its ``to_json``), atomically."""
+        write_json(self.to_json(), path)
+
+    @classmethod
+    def load(cls, path):
+        """A reader of this class from a JSON file (its ``from_json``, errors naming the file)."""
+        return cls.from_json(read_json(path), source=str(path))
 
     @property
     def landmark_bands(self) -> tuple[float, ...]:

@@ -49,7 +49,6 @@ from sklearn.base import BaseEstimator
 from sklearn.linear_model import LogisticRegression
 
 from .. import __version__
-from .._json import read_json, write_json
 from .._validate import check_format
 from ..errors import InputError, SwarmtopoError
 from ..topology.persistence import Diagram
@@ -316,13 +315,6 @@ class BettiClassifier(WindowReader, BaseEstimator):
         if obj.get("calibration"):
             model.calibration_ = _checked_calibration(obj["calibration"], model.theta_, source)
         return model
-
-    def save(self, path) -> None:
-        write_json(self.to_json(), path)
-
-    @classmethod
-    def load(cls, path) -> "BettiClassifier":
-        return cls.from_json(read_json(path), source=str(path))
 
     @classmethod
     def from_theta(cls, theta: dict[int, tuple[float, float, float]], provenance: dict) -> "BettiClassifier":

@@ -78,7 +78,6 @@ from sklearn.base import BaseEstimator
 from sklearn.linear_model import LogisticRegression
 
 from .. import __version__
-from .._json import read_json, write_json
 from .._validate import check_format
 from ..errors import InputError, SwarmtopoError
 from ..topology.persistence import Diagram
@@ -490,13 +489,6 @@ class RatioClassifier(WindowReader, BaseEstimator):
             "calibration": self.calibration_ or None,
             "provenance": {**self.provenance_, "swarmtopo": self.provenance_.get("swarmtopo", __version__)},
         }
-
-    def save(self, path) -> None:
-        write_json(self.to_json(), path)
-
-    @classmethod
-    def load(cls, path) -> "RatioClassifier":
-        return cls.from_json(read_json(path), source=str(path))
 
     @classmethod
     def from_json(cls, obj: dict, source: str = "<json>") -> "RatioClassifier":
