@@ -68,9 +68,9 @@ def agents_for(n_events: int) -> int:
 
 
 def simulated_log_dir(n_events: int, *, holes: int = 2, seed: int = 0,
-                      static_fraction: float = STATIC_FRACTION) -> Path:
+                      static_fraction: float = STATIC_FRACTION, agents: int | None = None) -> Path:
     """The cached log folder of :func:`simulated_log` (simulated and written on first use)."""
-    n_agents = agents_for(n_events)
+    n_agents = agents or agents_for(n_events)
     folder = cache_dir() / (f"sim{simulator_fingerprint()}-events{n_events}-holes{holes}-agents{n_agents}"
                             f"-static{static_fraction:g}-seed{seed}")
     if (folder / "meta.json").is_file():
@@ -90,7 +90,7 @@ def simulated_log_dir(n_events: int, *, holes: int = 2, seed: int = 0,
 
 
 def simulated_log(n_events: int, *, holes: int = 2, seed: int = 0,
-                  static_fraction: float = STATIC_FRACTION) -> EncounterLog:
+                  static_fraction: float = STATIC_FRACTION, agents: int | None = None) -> EncounterLog:
     """A simulated encounter log of about ``n_events`` events at the paper's density.
 
     Parameters
@@ -104,8 +104,23 @@ def simulated_log(n_events: int, *, holes: int = 2, seed: int = 0,
         Seed of the simulation (the arena is always ``random_arena(holes, rng=1)``).
     static_fraction
         Fraction of agents made static at t = 0 (hybrid network).
+    agents
+        Swarm size (default :func:`agents_for`); the arena is scaled to keep the density.
     """
-    return read_log(simulated_log_dir(n_events, holes=holes, seed=seed, static_fraction=static_fraction))
+    return read_log(simulated_log_dir(n_events, holes=holes, seed=seed, static_fraction=static_fraction,
+                                      agents=agents))
+
+
+def random_pair_log(n_events: int, *, agents: int = 2000, duration: float = 1000.0, seed: int = 0) -> EncounterLog:
+    """A log with no space in it: ``n_events`` encounters of uniformly random pairs of
+    ``agents`` agents at uniformly random times in [0, ``duration``] s, no status and no
+    meta (a contact trace).  The worst case of the encounter metric: every window's
+    graph is an expander, so its searches reach every node in a few hops."""
+    rng = np.random.default_rng(seed)
+    t = np.sort(rng.uniform(0.0, duration, n_events))
+    a = rng.integers(agents, size=n_events)
+    b = (a + rng.integers(1, agents, size=n_events)) % agents  # never a itself
+    return EncounterLog(t=t, a=np.minimum(a, b), b=np.maximum(a, b), agent_ids=np.arange(agents))
 
 
 def landmark_matrices(sizes, seed: int = 0) -> dict[int, np.ndarray]:

@@ -23,16 +23,16 @@ import numpy as np
 
 from _data import simulated_log
 from _measure import machine, revision
-from swarmtopo.pipeline import map as pipeline
+from swarmtopo.pipeline import tasks as pipeline
 from swarmtopo.metric.landmarks import covering_prefix
 from swarmtopo.pipeline import MapConfig, map_encounters
 
 SHIPPED = pipeline.subsample
 
 
-def cut_after(graph, config, n_landmarks, rng, candidates=None, cover=None):
+def cut_after(graph, config, n_landmarks, start, candidates=None, cover=None):
     """The baseline: every pick up to ``n_landmarks``, then the prefix ``cover`` keeps."""
-    land = SHIPPED(graph, config, n_landmarks, rng, candidates)
+    land = SHIPPED(graph, config, n_landmarks, start, candidates)
     return land if cover is None else covering_prefix(land, cover)
 
 

@@ -129,6 +129,7 @@ from scipy.sparse.csgraph import dijkstra, minimum_spanning_tree, shortest_path
 from swarmtopo.metric import graph as G
 from swarmtopo.metric import landmarks as L
 from swarmtopo.pipeline import map as P
+from swarmtopo.pipeline import tasks as T
 from swarmtopo.topology.embed import mds
 from swarmtopo.readers.registry import load_classifier
 from swarmtopo.errors import SwarmtopoError
@@ -247,17 +248,17 @@ def _witness_filtration(to_nodes: np.ndarray) -> np.ndarray:
 def _other_persistence(log, seed, persistence_of):
     """Map with ``persistence_of(window, sub, maxdim)`` (a PersistenceResult from a
     window's landmarks and its graph) instead of Vietoris-Rips on the landmarks' metric."""
-    original = P.map_window
+    original = P.map_band
 
-    def window_with_other_persistence(span, sub, knn_scale, n_land, config, rng, timings, say, band=1.0):
-        window = original(span, sub, knn_scale, n_land, config, rng, timings, say, band)
-        return dataclasses.replace(window, persistence=persistence_of(window, sub, config.maxdim))
+    def band_with_other_persistence(part, span, knn_scale, n_land, config, band, start):
+        window, *seconds = original(part, span, knn_scale, n_land, config, band, start)
+        return (dataclasses.replace(window, persistence=persistence_of(window, part, config.maxdim)), *seconds)
 
-    P.map_window = window_with_other_persistence
+    P.map_band = band_with_other_persistence
     try:
         return _windows_of(log, seed)
     finally:
-        P.map_window = original
+        P.map_band = original
 
 
 def _other_filtration(log, seed, values_of):
@@ -418,24 +419,24 @@ def _trajectory(log, seed, factor):
     """Landmarks and Rips on the chain graph's edges cut every ``factor`` x the window's
     k-NN scale s (virtual points along the agents' paths); landmarks cover to 1.5 s as
     by default."""
-    original = P.map_window
+    original = P.map_band
 
-    def window_on_paths(span, sub, knn_scale, n_land, config, rng, timings, say, band=1.0):
+    def window_on_paths(part, span, knn_scale, n_land, config, band, start):
         assert band == 1.0, band
-        dense = _subdivided(sub, factor * knn_scale)
-        land = P.subsample(dense, config, min(config.max_landmarks, dense.n_nodes), rng,
-                            cover=P.AUTO_COVER_FACTOR * knn_scale)
+        dense = _subdivided(part, factor * knn_scale)  # the part's nodes first: the start is one of them
+        land = T.subsample(dense, config, min(config.max_landmarks, dense.n_nodes), start,
+                           cover=T.AUTO_COVER_FACTOR * knn_scale)
         persistence = rips_persistence(land.distances, maxdim=config.maxdim)
-        return WindowMap(t0=0.0, t1=0.0, n_events=sub.n_events, landmarks=land,
-                           landmark_events=np.zeros(len(land.nodes), np.int64),
-                           scales=RegionScales(knn=knn_scale, cover_radius=float(land.cover_radius)),
-                           persistence=persistence)
+        return WindowMap(t0=0.0, t1=0.0, n_events=part.n_events, landmarks=land,
+                         landmark_events=np.zeros(len(land.nodes), np.int64),
+                         scales=RegionScales(knn=knn_scale, cover_radius=float(land.cover_radius)),
+                         persistence=persistence), 0.0, 0.0
 
-    P.map_window = window_on_paths
+    P.map_band = window_on_paths
     try:
         return _windows_of(log, seed, landmark_bands=(1.0,))
     finally:
-        P.map_window = original
+        P.map_band = original
 
 
 def _padded(log, seed, factor):
@@ -443,7 +444,7 @@ def _padded(log, seed, factor):
     sides, landmarks drawn only among the nodes inside the window (inside its landmark
     band, with bands): paths may leave the
     window in time, so the events at its edges are not outliers of a cut chain."""
-    original_map, original_subsample = P.map_window, P.subsample
+    original_map, original_subsample = P.map_band, T.subsample
     current = {"span": None, "band": 1.0}
 
     def build(log_, metric, *, window=None, **options):
@@ -452,21 +453,22 @@ def _padded(log, seed, factor):
             window = (window[0] - pad, window[1] + pad)
         return G.build_graph(log_, metric, window=window, **options)
 
-    def map_window(span, sub, knn_scale, n_land, config, rng, timings, say, band=1.0):
+    def map_band(part, span, knn_scale, n_land, config, band, start):
         current["span"], current["band"] = span, band
-        return original_map(span, sub, knn_scale, n_land, config, rng, timings, say, band)
+        return original_map(part, span, knn_scale, n_land, config, band, start)
 
-    def subsample(graph, config, n_landmarks, rng, candidates=None, cover=None):
+    def subsample(graph, config, n_landmarks, start, candidates=None, cover=None):
         if current["span"] is None:
-            return original_subsample(graph, config, n_landmarks, rng, candidates, cover)
-        return L.maxmin(graph, n_landmarks, rng=rng, cover=cover,
-                        candidates=in_band(graph.node_times(), current["span"], current["band"]))
+            return original_subsample(graph, config, n_landmarks, start, candidates, cover)
+        inside = in_band(graph.node_times(), current["span"], current["band"])
+        # the start was drawn among the padded window's band: fold it into the window's own
+        return L.maxmin(graph, n_landmarks, start=start % int(inside.sum()), cover=cover, candidates=inside)
 
-    P.map_window, P.subsample = map_window, subsample
+    P.map_band, T.subsample = map_band, subsample
     try:
         return _with_graphs(build, log, seed)
     finally:
-        P.map_window, P.subsample = original_map, original_subsample
+        P.map_band, T.subsample = original_map, original_subsample
 
 
 def config_override(text: str) -> dict:
@@ -559,12 +561,12 @@ def _covering(factor, inner):
     """``inner`` mapped with the automatic landmark count stopping at r_cover <= factor x
     the k-NN scale (``cover-F``)."""
     def mapper(log, seed):
-        original = P.AUTO_COVER_FACTOR
-        P.AUTO_COVER_FACTOR = factor
+        original = T.AUTO_COVER_FACTOR
+        T.AUTO_COVER_FACTOR = factor
         try:
             return inner(log, seed)
         finally:
-            P.AUTO_COVER_FACTOR = original
+            T.AUTO_COVER_FACTOR = original
     return mapper
 
 

@@ -46,7 +46,7 @@ from scipy.spatial import cKDTree
 
 from metric_vs_truth import geodesic_distances
 from swarmtopo.metric import landmarks as L
-from swarmtopo.pipeline import map as P
+from swarmtopo.pipeline import tasks as P
 from swarmtopo.metric import _kernels
 from swarmtopo.topology.cycles import event_positions
 from swarmtopo.experiments.accuracy import CELLS, tuning_arena
@@ -77,10 +77,10 @@ def _truth_maxmin(truth):
     """A stand-in for the pipeline's subsampler: landmarks in maxmin order on the true
     positions of the graph's nodes (their representative events), covering radii in the
     encounter metric (as maxmin's, so the pipeline's covering rule, ``cover``, applies unchanged)."""
-    def subsample(graph, config, n_landmarks, rng, candidates=None, cover=None):
+    def subsample(graph, config, n_landmarks, start, candidates=None, cover=None):
         arrays = L._GraphArrays.of(graph)
         positions = event_positions(truth, graph.representative_event())
-        start = int(np.random.default_rng(rng).integers(len(positions)))
+        start = int(start) % len(positions)  # a rank drawn among the band's nodes: a node of the graph
         nodes = _farthest_points(positions, n_landmarks, start)
         search = _kernels.Searcher(arrays.indptr, arrays.indices, arrays.weights)
         to_set, radii = np.full(arrays.n, np.inf), np.empty(len(nodes))

@@ -12,7 +12,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parent.parent / "src" / "swarmtopo"
 LAYERS = {
     "errors": 0, "data": 0,
-    "_validate": 1, "_json": 1,
+    "_validate": 1, "_json": 1, "_dask_plugin": 1,
     "log": 2, "arena": 2,
     "io": 3, "metric": 3, "topology": 3, "sim": 3,
     "readers": 4,

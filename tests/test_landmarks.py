@@ -397,3 +397,64 @@ def test_progress_reports_each_stage_once_in_order(method, stages):
     seen = []
     SUBSAMPLERS[method](random_geometric_graph(60, 0), 5, rng=0, progress=seen.append)
     assert seen == stages
+
+
+# -- bucket-queue searches and the drawn start --------------------------------------------
+def _arrays(g: Graph):
+    a = g.adjacency
+    return a.indptr.astype(np.int64), a.indices.astype(np.int64), a.data.astype(float)
+
+
+@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize("hop", [0.05, 0.0])
+def test_bucket_searches_give_the_heap_and_scipy_distances_bit_for_bit(seed, hop):
+    """Every label-setting search ends at the same floating-point fixpoint: the bucket
+    queue (with a per-hop cost, as the pipeline's weights have) and the heap agree bit
+    for bit with each other and with scipy, in parallel and in one thread."""
+    import numba
+
+    from swarmtopo.metric import _kernels
+
+    g = random_geometric_graph(300, seed)
+    indptr, indices, weights = _arrays(g)
+    weights = weights + hop
+    layout = _kernels.bucket_layout(weights)
+    assert (layout[1] > 0) == (hop > 0)  # without a floor on the weights, the heap is the better choice
+    nodes = np.random.default_rng(seed).choice(len(indptr) - 1, 40, replace=False)
+    scipy_rows = shortest_path(sp.csr_matrix((weights, indices, indptr)), indices=nodes)[:, nodes]
+    before = numba.get_num_threads()
+    try:
+        for threads in (1, before):
+            numba.set_num_threads(threads)
+            heap = _kernels.rows_to_targets(indptr, indices, weights, nodes, nodes, buckets=False)
+            buckets = _kernels.rows_to_targets(indptr, indices, weights, nodes, nodes)
+            assert np.array_equal(heap, buckets) and np.array_equal(heap, scipy_rows)
+    finally:
+        numba.set_num_threads(before)
+
+
+def test_bucket_layout_hand_computed():
+    from swarmtopo.metric._kernels import BUCKET_SPREAD, bucket_layout
+
+    assert bucket_layout(np.array([2.0, 3.0, 17.0])) == (1.0, 19)  # width: half the least; 17 / 1 + 2 buckets
+    spread = np.r_[1.0, np.full(9, 2 * BUCKET_SPREAD * 10 / 9)]  # mean over 32 x the least: heap
+    assert bucket_layout(spread) == (0.0, 0)
+
+
+@pytest.mark.parametrize("method", sorted(SUBSAMPLERS))
+def test_a_given_start_rank_is_the_draw_from_the_stream(method):
+    """The pipeline draws each window's start rank beforehand: rng.integers(pool size);
+    the subsampler given that rank starts where it would have drawn it."""
+    from swarmtopo.metric.landmarks import start_pool
+
+    g = random_geometric_graph(200, 3)
+    band = np.arange(g.adjacency.shape[0]) % 3 == 0
+    extra = {"candidates": band} if method == "maxmin" else {}
+    pool = start_pool(g, method, candidates=band if method == "maxmin" else None)
+    drawn = SUBSAMPLERS[method](g, 20, rng=np.random.default_rng(7), **extra)
+    rank = int(np.random.default_rng(7).integers(len(pool)))
+    given = SUBSAMPLERS[method](g, 20, start=rank, **extra)
+    assert drawn.params["start"] == given.params["start"] == pool[rank]
+    assert np.array_equal(drawn.nodes, given.nodes) and np.array_equal(drawn.distances, given.distances)
+    with pytest.raises(InputError, match="start must be a rank"):
+        SUBSAMPLERS[method](g, 20, start=len(pool), **extra)

@@ -58,10 +58,10 @@ def test_draws_of_a_variant_pool_that_variants_windows_at_consecutive_seeds():
 def test_padding_by_nothing_is_the_default_and_restores_the_pipeline():
     """``pad-0``: the window's own graph, every node a candidate, the same first pick: the default's diagrams."""
     log = simulate(random_arena(2, rng=4), 200, 30.0, rng=4).log
-    originals = (levers.P.weighted_chains, levers.P.map_window, levers.P.subsample)
+    originals = (levers.P.weighted_chains, levers.P.map_band, levers.T.subsample)
     padded, beta0 = levers._variant("pad-0")(log, 9)
     default, default_beta0 = levers._windows_of(log, 9)
-    assert (levers.P.weighted_chains, levers.P.map_window, levers.P.subsample) == originals
+    assert (levers.P.weighted_chains, levers.P.map_band, levers.T.subsample) == originals
     assert beta0 == default_beta0
     assert [[d.lengths(1).tolist() for d in r] for r in padded] == [[d.lengths(1).tolist() for d in r] for r in default]
     wider, _ = levers._variant("pad-0.5")(log, 9)

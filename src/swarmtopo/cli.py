@@ -380,6 +380,13 @@ def map_command(
         False, "--paper",
         help="Run the paper's pipeline: no per-hop cost, no diffusive weights, wall following like any time, the "
              "whole log, whole-window landmarks, the paper's classifier form."),
+    workers: Optional[int] = typer.Option(
+        None, "--workers", min=1,
+        help="Map the windows on an embedded Dask cluster of N worker processes (default: this process, one thread "
+             "per core). The map is the same bytes either way."),
+    scheduler: Optional[str] = typer.Option(
+        None, "--scheduler", help="Map the windows on an existing Dask cluster: its scheduler's address, e.g. "
+                                  "tcp://10.0.0.5:8786."),
     overwrite: bool = typer.Option(False, "--overwrite",
                                    help="Replace the map already in --out (its map files; other files stay)."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
@@ -393,6 +400,8 @@ def map_command(
     from .viz.report import MAP_FILES
 
     _check_verbosity(quiet, verbose)
+    if workers is not None and scheduler is not None:
+        raise typer.BadParameter("give --workers (a local cluster) or --scheduler (an existing one), not both")
     options = {"metric": metric, "subsample": subsample, "landmarks": landmarks, "window": window, "maxdim": maxdim,
                "seed": seed, "hop_cost": hop_cost, "diffusion_time": diffusion_time,
                "wall_follow_weight": wall_follow_weight, "window_length": window_length,
@@ -419,7 +428,8 @@ def map_command(
         if verbose:
             _detail(f"log {log_dir}: {log.n_events} encounters of {log.n_agents} agents from t = "
                     f"{exact_time(log.t[0])} to {exact_time(log.t[-1])} s")
-        tmap, written = _run_map(log, config, log_dir, stage.path, quiet, verbose, reader=model)
+        tmap, written = _run_map(log, config, log_dir, stage.path, quiet, verbose, reader=model,
+                                 engine={"workers": workers, "scheduler": scheduler})
     if not quiet:
         _print_verdict(tmap, truth=None)
         out.print(f"wrote {', '.join(str(stage.final_path(p)) for p in written)}", markup=False, highlight=False,
@@ -754,16 +764,17 @@ def _plan_answer(what: str, value: float, condition: str) -> str:
 
 
 def _run_map(log, config, log_dir: Path, out_dir: Path, quiet: bool, verbose: bool = False, reader=None,
-             ground_truth=None):
+             ground_truth=None, engine=None):
     """Map, write map.json and figures; ground truth beside the log only colours pictures,
     and a broken ground-truth file costs a warning, never the map.  ``ground_truth``
-    (arena, truth, trajectories): the caller's, instead of reading them beside the log."""
+    (arena, truth, trajectories): the caller's, instead of reading them beside the log;
+    ``engine``: map_encounters' ``workers`` / ``scheduler``."""
     from .pipeline import STAGES, map_encounters
     from .viz.report import write_map
 
     with _progress("mapping", quiet) as tick:
         try:
-            tmap = map_encounters(log, config, reader=reader,
+            tmap = map_encounters(log, config, reader=reader, **(engine or {}),
                                   progress=lambda stage: tick(STAGES.index(stage) / len(STAGES)))
         except SwarmtopoError as exc:
             if getattr(exc, "file", None):  # already names its file

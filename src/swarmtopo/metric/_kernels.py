@@ -8,6 +8,13 @@ of touched nodes): :func:`settle` stops after enough *counted* nodes are settled
 (k-NN rows; landmark-to-landmark rows, where scipy took 133 ms per source at 685k
 nodes against 41 ms here with two threads, benchmarks/bench_landmarks.py), and
 :func:`lower_distances` stops at every node it cannot improve (maxmin picks).
+Landmark-to-landmark rows search with a bucket queue instead of the heap when every
+edge weighs at least a fair share of the mean (:func:`settle_buckets`: the per-hop
+cost h makes it so), with the same distances bit for bit, 2x faster.
+
+Drivers run parallel over sources on numba's threads, or serially without the GIL in
+a thread limited to one numba thread, so that the pipeline's window tasks can run
+side by side in threads.
 
 All drivers are deterministic: every source's search is independent, so the parallel
 split over sources changes nothing but the time.
@@ -132,7 +139,7 @@ def settle(indptr, indices, weights, source, count, stop_count,
     return n_found
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def lower_distances(indptr, indices, weights, source, to_set, dist, touched, heap_keys, heap_nodes, limit):
     """Lower ``to_set[x]`` to d(source, x) wherever that is smaller and at most ``limit``, in place.
 
@@ -188,64 +195,208 @@ class Searcher:
                                self.touched, self.heap_keys, self.heap_nodes, float(limit))
 
 
-@njit(cache=True, parallel=True)
-def _knn_rows(indptr, indices, weights, multiplicity, k, n_blocks):
+@njit(cache=True, nogil=True)
+def _knn_block(indptr, indices, weights, multiplicity, k, block, n_blocks, out):
+    """k-NN rows of the nodes block, block + n_blocks, ... into ``out``."""
     n = len(indptr) - 1
-    out = np.full((n, k), np.inf)
+    dist = np.full(n, np.inf)
+    touched = np.empty(n, np.int64)
+    heap_keys = np.empty(len(weights) + 1)
+    heap_nodes = np.empty(len(weights) + 1, np.int64)
+    found_node = np.empty(k + 1, np.int64)
+    found_dist = np.empty(k + 1)
+    for x in range(block, n, n_blocks):
+        # stop once x's own points plus k others are settled: each node counts its
+        # multiplicity, so at most k + 1 nodes are found
+        n_found = settle(indptr, indices, weights, x, multiplicity, k + 1,
+                         dist, touched, heap_keys, heap_nodes, found_node, found_dist)
+        filled = 0
+        for j in range(n_found):
+            copies = multiplicity[found_node[j]] - (1 if j == 0 else 0)  # j == 0 is x
+            for _ in range(copies):
+                if filled == k:
+                    break
+                out[x, filled] = found_dist[j]
+                filled += 1
+
+
+@njit(cache=True, parallel=True)
+def _knn_rows_parallel(indptr, indices, weights, multiplicity, k, n_blocks):
+    out = np.full((len(indptr) - 1, k), np.inf)
     for block in prange(n_blocks):
-        dist = np.full(n, np.inf)
-        touched = np.empty(n, np.int64)
-        heap_keys = np.empty(len(weights) + 1)
-        heap_nodes = np.empty(len(weights) + 1, np.int64)
-        found_node = np.empty(k + 1, np.int64)
-        found_dist = np.empty(k + 1)
-        for x in range(block, n, n_blocks):
-            # stop once x's own points plus k others are settled: each node counts its
-            # multiplicity, so at most k + 1 nodes are found
-            n_found = settle(indptr, indices, weights, x, multiplicity, k + 1,
-                             dist, touched, heap_keys, heap_nodes, found_node, found_dist)
-            filled = 0
-            for j in range(n_found):
-                copies = multiplicity[found_node[j]] - (1 if j == 0 else 0)  # j == 0 is x
-                for _ in range(copies):
-                    if filled == k:
-                        break
-                    out[x, filled] = found_dist[j]
-                    filled += 1
+        _knn_block(indptr, indices, weights, multiplicity, k, block, n_blocks, out)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _knn_rows_serial(indptr, indices, weights, multiplicity, k):
+    out = np.full((len(indptr) - 1, k), np.inf)
+    _knn_block(indptr, indices, weights, multiplicity, k, 0, 1, out)
     return out
 
 
 def knn_rows(indptr, indices, weights, multiplicity, k: int) -> np.ndarray:
-    """``(n, k)`` distances from every node to its k nearest other points (see landmarks)."""
-    return _knn_rows(indptr, indices, weights, multiplicity, k, get_num_threads())
+    """``(n, k)`` distances from every node to its k nearest other points (see landmarks).
+
+    Parallel over nodes on numba's threads; in a thread limited to one numba thread
+    (``numba.set_num_threads(1)``, as the pipeline's window tasks are), serial and
+    without the GIL, so that tasks run side by side in threads."""
+    if get_num_threads() == 1:
+        return _knn_rows_serial(indptr, indices, weights, multiplicity, k)
+    return _knn_rows_parallel(indptr, indices, weights, multiplicity, k, get_num_threads())
+
+
+# -- landmark-to-landmark rows: a bucket queue where the weights allow it -------------
+BUCKET_SPREAD = 32.0
+"""Largest mean / least edge weight for which the searches use buckets: each search
+steps through about (eccentricity / bucket width) buckets, so the ratio bounds the
+empty buckets it scans per settled hop."""
+MAX_BUCKETS = 1 << 20
+"""Most buckets of the circular bucket array (the longest edge over the bucket width)."""
+
+
+def bucket_layout(weights: np.ndarray) -> tuple[float, int]:
+    """(bucket width, number of buckets) of :func:`settle_buckets` on these edge weights
+    (all > 0), or (0, 0) when the heap search is the better choice.
+
+    The width is half the least weight: a node settled at d relaxes its neighbours to
+    at least d + 2 x width, two buckets on, so every node left in the lowest non-empty
+    bucket is already final, with a whole bucket of margin for rounding."""
+    if not len(weights):
+        return 0.0, 0
+    least = float(weights.min())
+    width = least / 2
+    n_buckets = int(float(weights.max()) / width) + 2
+    if float(weights.mean()) > BUCKET_SPREAD * least or n_buckets > MAX_BUCKETS:
+        return 0.0, 0
+    return width, n_buckets
+
+
+@njit(cache=True, nogil=True)
+def settle_buckets(indptr, indices, weights, source, is_target, n_targets, width, n_buckets,
+                   dist, touched, head, entry_next, entry_node, entry_key, found_node, found_dist):
+    """Dijkstra from ``source`` until the ``n_targets`` nodes with ``is_target`` are settled,
+    with a circular bucket queue (Dial's) of ``n_buckets`` buckets ``width`` wide
+    (:func:`bucket_layout`) instead of a heap.
+
+    Each bucket is a linked list of (node, key) entries, one per strict improvement (a
+    lazy queue, as :func:`settle`'s heap).  Every node in the lowest non-empty bucket
+    is final (no edge is shorter than two widths), so a bucket's nodes are settled in
+    any order.  Each final distance is the least of fl(d(u) + w(u, v)) over the final
+    distances of its neighbours, as in any label-setting search, so the distances are
+    bit for bit those of :func:`settle`; the found nodes come in bucket order, not in
+    distance order.  Scratch as in :func:`settle`, plus ``head`` (n_buckets,) all -1 on
+    entry and exit and entries of length nnz + 1.  Returns the number of found nodes.
+    """
+    n_found = 0
+    dist[source] = 0.0
+    touched[0] = source
+    n_touched = 1
+    entry_node[0] = source
+    entry_key[0] = 0.0
+    entry_next[0] = -1
+    head[0] = 0
+    n_entries = 1
+    live = 1
+    bucket = 0
+    while live > 0:
+        slot = bucket % n_buckets
+        e = head[slot]
+        if e < 0:
+            bucket += 1
+            continue
+        head[slot] = entry_next[e]
+        live -= 1
+        u = entry_node[e]
+        d = entry_key[e]
+        if d > dist[u]:
+            continue  # stale entry
+        if is_target[u]:
+            found_node[n_found] = u
+            found_dist[n_found] = d
+            n_found += 1
+            if n_found == n_targets:
+                break
+        for k in range(indptr[u], indptr[u + 1]):
+            v = indices[k]
+            nd = d + weights[k]
+            if nd < dist[v]:
+                if dist[v] == np.inf:
+                    touched[n_touched] = v
+                    n_touched += 1
+                dist[v] = nd
+                b = int(nd / width) % n_buckets
+                entry_node[n_entries] = v
+                entry_key[n_entries] = nd
+                entry_next[n_entries] = head[b]
+                head[b] = n_entries
+                n_entries += 1
+                live += 1
+    _restore(dist, touched, n_touched)
+    for i in range(n_buckets):
+        head[i] = -1
+    return n_found
+
+
+@njit(cache=True, nogil=True)
+def _rows_block(indptr, indices, weights, sources, targets, is_target, column, width, n_buckets,
+                block, n_blocks, out):
+    """Rows block, block + n_blocks, ... of :func:`rows_to_targets` into ``out``."""
+    n = len(indptr) - 1
+    n_targets = len(targets)
+    dist = np.full(n, np.inf)
+    touched = np.empty(n, np.int64)
+    found_node = np.empty(n_targets, np.int64)
+    found_dist = np.empty(n_targets)
+    m = len(weights) + 1
+    if n_buckets > 0:
+        head = np.full(n_buckets, -1, np.int64)
+        entry_next = np.empty(m, np.int64)
+        entry_node = np.empty(m, np.int64)
+        entry_key = np.empty(m)
+    else:
+        heap_keys = np.empty(m)
+        heap_nodes = np.empty(m, np.int64)
+    for i in range(block, len(sources), n_blocks):
+        if n_buckets > 0:
+            n_found = settle_buckets(indptr, indices, weights, sources[i], is_target, n_targets, width, n_buckets,
+                                     dist, touched, head, entry_next, entry_node, entry_key, found_node, found_dist)
+        else:
+            n_found = settle(indptr, indices, weights, sources[i], is_target, n_targets,
+                             dist, touched, heap_keys, heap_nodes, found_node, found_dist)
+        for j in range(n_found):
+            out[i, column[found_node[j]]] = found_dist[j]
+
+
+@njit(cache=True, nogil=True)
+def _target_columns(n, targets):
+    column = np.full(n, -1, np.int64)
+    is_target = np.zeros(n, np.int64)
+    for j in range(len(targets)):
+        column[targets[j]] = j
+        is_target[targets[j]] = 1
+    return column, is_target
 
 
 @njit(cache=True, parallel=True)
-def _rows_to_targets(indptr, indices, weights, sources, targets, n_blocks):
-    n = len(indptr) - 1
-    n_targets = len(targets)
-    column = np.full(n, -1, np.int64)
-    is_target = np.zeros(n, np.int64)
-    for j in range(n_targets):
-        column[targets[j]] = j
-        is_target[targets[j]] = 1
-    out = np.full((len(sources), n_targets), np.inf)
+def _rows_parallel(indptr, indices, weights, sources, targets, width, n_buckets, n_blocks):
+    column, is_target = _target_columns(len(indptr) - 1, targets)
+    out = np.full((len(sources), len(targets)), np.inf)
     for block in prange(n_blocks):
-        dist = np.full(n, np.inf)
-        touched = np.empty(n, np.int64)
-        heap_keys = np.empty(len(weights) + 1)
-        heap_nodes = np.empty(len(weights) + 1, np.int64)
-        found_node = np.empty(n_targets, np.int64)
-        found_dist = np.empty(n_targets)
-        for i in range(block, len(sources), n_blocks):
-            n_found = settle(indptr, indices, weights, sources[i], is_target, n_targets,
-                             dist, touched, heap_keys, heap_nodes, found_node, found_dist)
-            for j in range(n_found):
-                out[i, column[found_node[j]]] = found_dist[j]
+        _rows_block(indptr, indices, weights, sources, targets, is_target, column, width, n_buckets,
+                    block, n_blocks, out)
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
+def _rows_serial(indptr, indices, weights, sources, targets, width, n_buckets):
+    column, is_target = _target_columns(len(indptr) - 1, targets)
+    out = np.full((len(sources), len(targets)), np.inf)
+    _rows_block(indptr, indices, weights, sources, targets, is_target, column, width, n_buckets, 0, 1, out)
+    return out
+
+
+@njit(cache=True, nogil=True)
 def symmetrize_min(matrix):
     """In place: matrix[i, j] = matrix[j, i] = min of the two; zero diagonal."""
     for i in range(matrix.shape[0]):
@@ -257,9 +408,15 @@ def symmetrize_min(matrix):
     return matrix
 
 
-def rows_to_targets(indptr, indices, weights, sources, targets) -> np.ndarray:
+def rows_to_targets(indptr, indices, weights, sources, targets, *, buckets: bool = True) -> np.ndarray:
     """``(len(sources), len(targets))`` exact distances; each search stops at the last target.
 
-    ``targets`` must be distinct.  Parallel over sources (numba threads).
+    ``targets`` must be distinct.  Searches use a bucket queue when the weights suit
+    one (:func:`bucket_layout`; ``buckets=False``: always the heap), with the same
+    distances bit for bit.  Parallel over sources on numba's threads; serial and
+    without the GIL in a thread limited to one numba thread (see :func:`knn_rows`).
     """
-    return _rows_to_targets(indptr, indices, weights, sources, targets, get_num_threads())
+    width, n_buckets = bucket_layout(weights) if buckets else (0.0, 0)
+    if get_num_threads() == 1:
+        return _rows_serial(indptr, indices, weights, sources, targets, width, n_buckets)
+    return _rows_parallel(indptr, indices, weights, sources, targets, width, n_buckets, get_num_threads())

@@ -83,7 +83,7 @@ class Landmarks:
 
 
 def maxmin(graph, n_landmarks: int, *, rng=None, progress: Progress | None = None,
-           candidates: np.ndarray | None = None, cover: float | None = None) -> Landmarks:
+           candidates: np.ndarray | None = None, cover: float | None = None, start: int | None = None) -> Landmarks:
     """Maxmin (farthest-point) landmarks: l_k = argmax_x d(x, L).
 
     Parameters
@@ -105,6 +105,10 @@ def maxmin(graph, n_landmarks: int, *, rng=None, progress: Progress | None = Non
         Optional radius: stop at the first pick that brings the covering radius to at
         most ``cover`` (at least ``MIN_LANDMARKS`` picks), so L is then how many the
         greedy run needs to cover within ``cover``, at most ``n_landmarks``.
+    start
+        Optional rank of l_1 among the start pool (:func:`start_pool`), instead of a
+        draw from ``rng``: the draw is ``rng.integers(pool size)``, so a caller that
+        draws it elsewhere (the pipeline, before its window tasks run) gets the same l_1.
 
     Returns
     -------
@@ -124,14 +128,14 @@ def maxmin(graph, n_landmarks: int, *, rng=None, progress: Progress | None = Non
         if candidates.shape != (arrays.n,) or not candidates.any():
             raise InputError(f"candidates must be a bool mask of shape ({arrays.n},) with at least one node set, "
                              f"got shape {candidates.shape} with {int(candidates.sum())} set")
-    start = _random_candidate(candidates, rng)
+    start = _start_node(candidates, rng, start)
     notify("picks")
     nodes, radii = _pick(arrays, candidates, n_landmarks, start, cover=cover)
     return _result(arrays, nodes, radii, "maxmin", {"start": start}, notify)
 
 
 def knn_maxmin(graph, n_landmarks: int, *, k: int = 10, q: float = 0.9, rng=None,
-               progress: Progress | None = None, cover: float | None = None) -> Landmarks:
+               progress: Progress | None = None, cover: float | None = None, start: int | None = None) -> Landmarks:
     """KNN-filtered maxmin: maxmin on the points with d̄_k(x) <= tau_{q,k}.
 
     d̄_k(x) is the mean distance to the k nearest other points (events, so a node of
@@ -156,6 +160,8 @@ def knn_maxmin(graph, n_landmarks: int, *, k: int = 10, q: float = 0.9, rng=None
         ``"distances"``) and with ``"done"`` at the end.
     cover
         As for :func:`maxmin` (the covering radius over the kept set V).
+    start
+        As for :func:`maxmin` (a rank among the kept nodes).
 
     Returns
     -------
@@ -173,18 +179,17 @@ def knn_maxmin(graph, n_landmarks: int, *, k: int = 10, q: float = 0.9, rng=None
     rng = np.random.default_rng(rng)
     notify = progress or _quiet
     notify("knn")
-    mean_knn = _mean_knn_distance(arrays, k)
-    threshold = float(np.quantile(np.repeat(mean_knn, arrays.multiplicity), q))
-    candidates = mean_knn <= threshold
-    start = _random_candidate(candidates, rng)
+    candidates, threshold = _knn_kept(arrays, k, q)
+    start = _start_node(candidates, rng, start)
     notify("picks")
     nodes, radii = _pick(arrays, candidates, n_landmarks, start, cover=cover)
     params = {"k": k, "q": q, "threshold": threshold, "n_kept": int(candidates.sum()), "start": start}
     return _result(arrays, nodes, radii, "knn", params, notify)
 
 
-def probabilistic_maxmin(graph, n_landmarks: int, *, k: int = 10, omega: float = 1.0,
-                         rng=None, progress: Progress | None = None, cover: float | None = None) -> Landmarks:
+def probabilistic_maxmin(graph, n_landmarks: int, *, k: int = 10, omega: float = 1.0, rng=None,
+                         progress: Progress | None = None, cover: float | None = None,
+                         start: int | None = None) -> Landmarks:
     r"""Probabilistic maxmin: l_k = argmax_x alpha(d(x, L), v(x)), alpha(u, v) = u + omega v.
 
     The paper's v is a local density and omega a constant, which makes omega carry
@@ -216,7 +221,7 @@ def probabilistic_maxmin(graph, n_landmarks: int, *, k: int = 10, omega: float =
         Seed or Generator; l_1 is a node drawn uniformly at random.
     progress
         As for :func:`knn_maxmin`.
-    cover
+    cover, start
         As for :func:`maxmin`.
 
     Returns
@@ -234,7 +239,7 @@ def probabilistic_maxmin(graph, n_landmarks: int, *, k: int = 10, omega: float =
     notify("knn")
     density_rank = _density_rank(_mean_knn_distance(arrays, k), arrays.multiplicity)
     candidates = np.ones(arrays.n, bool)
-    start = _random_candidate(candidates, rng)
+    start = _start_node(candidates, rng, start)
     notify("picks")
     nodes, radii = _pick(arrays, candidates, n_landmarks, start,
                          bonus=lambda radius: (omega * radius) * density_rank, cover=cover)
@@ -314,9 +319,34 @@ def _check_connected(arrays: _GraphArrays) -> None:
             f"{arrays.n} nodes): landmarks need one component; split the graph into components first")
 
 
-def _random_candidate(candidates: np.ndarray, rng: np.random.Generator) -> int:
+def start_pool(graph, method: str, *, k: int = 10, q: float = 0.9,
+               candidates: np.ndarray | None = None) -> np.ndarray:
+    """The nodes l_1 is drawn from, in index order: ``candidates`` (maxmin; None: every
+    node), the kept set V (knn) or every node (probabilistic).  A subsampler called with
+    ``start=i`` starts at the pool's i-th node, as with a drawn ``rng.integers(len(pool))``."""
+    arrays = _GraphArrays.of(graph)
+    if method == "knn":
+        return np.flatnonzero(_knn_kept(arrays, positive_int("k", k), q)[0])
+    if method == "maxmin" and candidates is not None:
+        return np.flatnonzero(candidates)
+    return np.arange(arrays.n)
+
+
+def _start_node(candidates: np.ndarray, rng: np.random.Generator, rank: int | None) -> int:
+    """l_1: the pool's node at ``rank``, else at a rank drawn from ``rng``."""
     pool = np.flatnonzero(candidates)
-    return int(pool[rng.integers(len(pool))])
+    if rank is None:
+        rank = rng.integers(len(pool))
+    elif not 0 <= rank < len(pool):
+        raise InputError(f"start must be a rank in the start pool of {len(pool)} nodes", value=rank)
+    return int(pool[rank])
+
+
+def _knn_kept(arrays: _GraphArrays, k: int, q: float) -> tuple[np.ndarray, float]:
+    """(V as a node mask, tau_{q,k}): the nodes whose mean k-NN distance is at most its q-quantile."""
+    mean_knn = _mean_knn_distance(arrays, k)
+    threshold = float(np.quantile(np.repeat(mean_knn, arrays.multiplicity), q))
+    return mean_knn <= threshold, threshold
 
 
 def _mean_knn_distance(arrays: _GraphArrays, k: int) -> np.ndarray:

@@ -5,8 +5,9 @@ The stages, in order (paper, "Algorithm Overview", and swarmtopo's windows)::
     resolve settings (h, tau, windows, bands)      pipeline.settings
     weighted chain graph of the mapped events       metric.graph
     components -> regions, beta_0 evidence          pipeline.regions
-    each window's graph, cut from the one graph     metric.graph.WeightedChains.graph
-    per region and window: landmarks, persistence   metric.landmarks, topology.persistence
+    per window and region, as tasks on an engine:   pipeline.tasks, pipeline.engine
+      the window's graph, cut from the one graph    metric.graph.WeightedChains.graph
+      landmarks, persistence                        metric.landmarks, topology.persistence
     per region: Betti numbers and confidence        readers (one reader.read call)
     per region: MDS picture, loops round the holes  topology.embed, topology.cycles
     assemble the map                                pipeline.result
@@ -20,13 +21,13 @@ from __future__ import annotations
 
 import time
 from dataclasses import replace
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
 from ..log import EncounterLog
-from ..metric.graph import EncounterGraph, weighted_chains
-from ..metric.landmarks import MIN_LANDMARKS, Landmarks, knn_distances, knn_maxmin, maxmin, probabilistic_maxmin
+from ..metric.graph import weighted_chains
+from ..metric.landmarks import MIN_LANDMARKS
 from ..readers.base import BettiReader
 from ..readers.beta0 import shipped_beta0_model
 from ..readers.registry import load_classifier, shipped_reader_for
@@ -34,16 +35,12 @@ from ..topology.cycles import region_cycles
 from ..topology.embed import mds
 from ..topology.persistence import Diagram, rips_persistence
 from .config import MapConfig
-from .regions import MIN_REGION_AGENTS, region_part, split_regions
-from .result import RegionMap, RegionScales, TopologicalMap, WindowMap, software_versions
+from .engine import engine_for
+from .regions import MIN_REGION_AGENTS, split_regions
+from .result import RegionMap, TopologicalMap, WindowMap, software_versions
 from .settings import Settings, resolve
-from .windows import in_band, silence_warnings, usable_bands
-
-AUTO_COVER_FACTOR = 1.5
-"""The automatic landmark count stops once r_cover <= AUTO_COVER_FACTOR * s (s: the
-window's k-NN scale).  The landmarks' diagram is within bottleneck 2 r_cover of the
-whole cloud's, so subsampling moves no bar by more than 3 s: the order of the
-cloud's own Rips noise bars."""
+from .tasks import AUTO_COVER_FACTOR, cut_window, describe_part, map_band, window_part
+from .windows import silence_warnings
 CALIBRATED_HOLES = 3
 """The most holes of any arena the confidence was calibrated on (the accuracy
 benchmark's cells: 0-3); a map counting more says its confidence is extrapolated."""
@@ -57,6 +54,8 @@ def map_encounters(
     *,
     reader: BettiReader | None = None,
     progress: Callable[[str], None] | None = None,
+    workers: int | None = None,
+    scheduler: Any = None,
 ) -> TopologicalMap:
     """Map an encounter log to Betti numbers, diagrams and pictures.
 
@@ -71,6 +70,12 @@ def map_encounters(
         shipped one for the log (``default`` with status changes, ``trace`` without).
     progress
         Optional callable receiving the name of each stage (``STAGES``) as it starts.
+    workers
+        Run the window tasks on an embedded Dask cluster of this many worker processes
+        (default: this process's threads, one per numba thread).
+    scheduler
+        Run them on an existing Dask cluster instead: its scheduler's address, or a
+        ``distributed.Client``.  The map is the same bytes on every engine.
 
     Returns
     -------
@@ -80,7 +85,7 @@ def map_encounters(
     ------
     SwarmtopoError
         If the (windowed) log has too few events, or no component is big enough
-        to count as a region.
+        to count as a region; or the Dask scheduler cannot be reached.
     """
     config = (config or MapConfig()).validate()
     reader = reader or load_classifier(shipped_reader_for(log))
@@ -95,19 +100,15 @@ def map_encounters(
                              diffusion_time=settings.diffusion_time[0], wall_follow_weight=config.wall_follow_weight)
     graph = chains.graph()
     split = split_regions(log, graph, config.min_region_events, settings.agent_gap)
-    window_graphs = [(None, graph, split.labels) if span is None else (span, *_labelled(chains.graph(span)))
-                     for span in settings.spans]
     timings["graph"] = time.perf_counter() - t0
 
     events_per_region = split.events_per_comp[split.regions]
     shares = (share_landmarks(config.landmarks, events_per_region) if config.landmarks
               else [None] * len(split.regions))
-    regions = []
-    for comp, n_land in zip(split.regions, shares):
-        region_events = graph.event_index[split.event_comp == comp]
-        windows, notes = _region_windows(comp, region_events, window_graphs, graph, split.labels, log, config,
-                                         settings, n_land, rng, timings, say)
-        regions.append(_read_region(comp, split, windows, notes, reader, config, rng, timings, say))
+    with engine_for(workers, scheduler) as engine:
+        mapped = _map_windows(engine, chains, graph, split, log, config, settings, shares, rng, timings, say)
+    regions = [_read_region(comp, split, windows, notes, reader, config, mds_seed, timings, say)
+               for comp, (windows, notes, mds_seed) in zip(split.regions, mapped)]
 
     betti: dict[int, int | None] = {0: len(regions)}
     confidence: dict[int, float | None] = {0: shipped_beta0_model().confidence(split.beta0)}
@@ -138,43 +139,66 @@ def map_encounters(
     )
 
 
-def _labelled(graph: EncounterGraph) -> tuple[EncounterGraph, np.ndarray]:
-    return graph, graph.components()[1]
+def _map_windows(engine, chains, graph, split, log, config: MapConfig, settings: Settings, shares, rng, timings,
+                 say) -> list[tuple[list[WindowMap], list[str], int | None]]:
+    """Every region's windows, each mapped once per usable landmark band (the region's
+    whole log instead when no window holds enough of it), with notes on what was
+    skipped and the region's MDS seed, as tasks on ``engine``.
 
-
-def _region_windows(comp, region_events, window_graphs, graph, labels, log, config: MapConfig, settings: Settings,
-                    n_land, rng, timings, say) -> tuple[list[WindowMap], list[str]]:
-    """Every window of one region, mapped once per usable landmark band; the region's
-    whole log instead when no window holds enough of it; and notes on what was skipped."""
+    The random draws -- each mapped band's landmark start, then the region's MDS seed,
+    region by region -- are made here, in that order, from the map's one stream, so the
+    tasks' order of completion changes nothing."""
+    say("landmarks")
     bands = settings.landmark_bands
-    windows, notes, quiet = [], [], 0
-    for span, wgraph, wlabels in window_graphs:
-        part = region_part(wgraph, wlabels, region_events, log, config.min_region_events)
-        if part is not None:
-            knn_scale = _timed(timings, "landmarks", knn_scale_of, part, config.knn_k)  # one per window
-            usable = usable_bands(part, span, bands)
-            quiet += len(usable) < len(bands)
-            windows += [map_window(span, part, knn_scale, n_land, config, rng, timings, say, band) for band in usable]
-    if not windows:  # no window holds enough of this region: map its whole log instead
-        whole = graph.subgraph(np.flatnonzero(labels == comp))
-        knn_scale = _timed(timings, "landmarks", knn_scale_of, whole, config.knn_k)
-        usable = usable_bands(whole, None, bands)
-        quiet = int(len(usable) < len(bands))
-        windows = [map_window(None, whole, knn_scale, n_land, config, rng, timings, say, band) for band in usable]
-        if settings.tried:
-            lo, hi = settings.tried[0], settings.tried[-1]
-            tried = f"{lo:.3g}" if lo == hi else f"{lo:.3g}-{hi:.3g}"
-            notes.append(f"no window ({tried} s long) holds {config.min_region_events} encounters of this region "
-                         f"among {MIN_REGION_AGENTS} agents: its whole log was mapped instead")
-    if quiet:
-        notes.append(f"windows of this region with fewer than {MIN_LANDMARKS} encounters in the middle share "
-                     f"of their time span a landmark band draws from (a quiet stretch of the log): {quiet}; "
-                     f"they were mapped without that band")
-    return windows, notes
+    shared_chains, shared_log = engine.share(chains), engine.share(log)
+    cuts = [engine.submit(cut_window, shared_chains, span) for span in settings.spans]
+    parts, infos = [], []
+    for comp in split.regions:
+        region_events = engine.share(graph.event_index[split.event_comp == comp])
+        parts.append([engine.submit(window_part, cut, region_events, shared_log, config.min_region_events)
+                      for cut in cuts])
+        infos.append([engine.submit(describe_part, part, span, bands, config)
+                      for part, span in zip(parts[-1], settings.spans)])
+    described = [engine.gather(region_infos) for region_infos in infos]
+
+    plans = []  # per region: [(part, span, info)], notes
+    for comp, region_parts, region_infos in zip(split.regions, parts, described):
+        plan = [(part, span, info) for part, span, info in zip(region_parts, settings.spans, region_infos)
+                if info is not None]
+        notes = []
+        if not plan:  # no window holds enough of this region: map its whole log instead
+            whole = engine.share(graph.subgraph(np.flatnonzero(split.labels == comp)))
+            plan = [(whole, None, engine.gather([engine.submit(describe_part, whole, None, bands, config)])[0])]
+            if settings.tried:
+                lo, hi = settings.tried[0], settings.tried[-1]
+                tried = f"{lo:.3g}" if lo == hi else f"{lo:.3g}-{hi:.3g}"
+                notes.append(f"no window ({tried} s long) holds {config.min_region_events} encounters of this "
+                             f"region among {MIN_REGION_AGENTS} agents: its whole log was mapped instead")
+        quiet = sum(len(info.bands) < len(bands) for _, _, info in plan)
+        if quiet:
+            notes.append(f"windows of this region with fewer than {MIN_LANDMARKS} encounters in the middle share "
+                         f"of their time span a landmark band draws from (a quiet stretch of the log): {quiet}; "
+                         f"they were mapped without that band")
+        plans.append((plan, notes))
+
+    say("persistence")
+    submitted = []
+    for (plan, notes), n_land in zip(plans, shares):
+        tasks = [engine.submit(map_band, part, span, info.knn_scale, n_land, config, band, int(rng.integers(pool)))
+                 for part, span, info in plan for band, pool in zip(info.bands, info.pool_sizes)]
+        mds_seed = int(rng.integers(2**31 - 1)) if config.embed_dim else None
+        submitted.append((tasks, notes, mds_seed))
+    mapped = []
+    for tasks, notes, mds_seed in submitted:
+        results = engine.gather(tasks)
+        timings["landmarks"] += sum(r[1] for r in results)
+        timings["persistence"] += sum(r[2] for r in results)
+        mapped.append(([r[0] for r in results], notes, mds_seed))
+    return mapped
 
 
 def _read_region(comp, split, windows: list[WindowMap], notes: list[str], reader: BettiReader, config: MapConfig,
-                 rng, timings, say) -> RegionMap:
+                 mds_seed: int | None, timings, say) -> RegionMap:
     """The reader's Betti numbers over the region's windows, its picture and its loops."""
     say("classify")
     t0 = time.perf_counter()
@@ -189,7 +213,7 @@ def _read_region(comp, split, windows: list[WindowMap], notes: list[str], reader
 
     say("embedding")
     t0 = time.perf_counter()
-    embedding = (mds(chosen.landmarks.distances, dim=config.embed_dim, rng=rng)
+    embedding = (mds(chosen.landmarks.distances, dim=config.embed_dim, rng=mds_seed)
                  if config.embed_dim and len(chosen.landmarks.nodes) > config.embed_dim else None)
     timings["embedding"] += time.perf_counter() - t0
     region = RegionMap(
@@ -222,50 +246,6 @@ def _read_region(comp, split, windows: list[WindowMap], notes: list[str], reader
     return region
 
 
-def map_window(span, sub: EncounterGraph, knn_scale: float, n_land: int | None, config: MapConfig, rng,
-               timings: dict[str, float], say, band: float = 1.0) -> WindowMap:
-    """Landmarks and persistence of one region's events in one time window (span None:
-    all), the landmarks drawn among the nodes of the window's middle ``band`` share;
-    ``knn_scale`` is the window's s, shared by its bands."""
-    say("landmarks")
-    t0 = time.perf_counter()
-    t_lo, t_hi = (float(sub.event_t.min()), float(sub.event_t.max())) if span is None else span
-    candidates = None if band == 1 else in_band(sub.node_times(), (t_lo, t_hi), band)
-    if n_land is None:  # as many as cover the window to AUTO_COVER_FACTOR s, at most max_landmarks
-        land = subsample(sub, config, min(config.max_landmarks, sub.n_nodes), rng, candidates,
-                         cover=AUTO_COVER_FACTOR * knn_scale)
-    else:
-        land = subsample(sub, config, int(min(n_land, sub.n_nodes)), rng, candidates)
-    timings["landmarks"] += time.perf_counter() - t0
-    say("persistence")
-    t0 = time.perf_counter()
-    persistence = rips_persistence(land.distances, maxdim=config.maxdim)
-    timings["persistence"] += time.perf_counter() - t0
-    return WindowMap(t0=t_lo, t1=t_hi, n_events=sub.n_events, landmarks=land,
-                     landmark_events=sub.representative_event()[land.nodes],
-                     scales=RegionScales(knn=knn_scale, cover_radius=float(land.cover_radius)),
-                     persistence=persistence, band=float(band))
-
-
-def subsample(graph: EncounterGraph, config: MapConfig, n_landmarks: int, rng,
-              candidates: np.ndarray | None = None, cover: float | None = None) -> Landmarks:
-    """Landmarks by ``config.subsample``; ``candidates`` (maxmin only, as validated) restricts
-    the picks; ``cover`` stops them once they cover within it."""
-    if config.subsample == "knn":
-        return knn_maxmin(graph, n_landmarks, k=config.knn_k, q=config.knn_q, rng=rng, cover=cover)
-    if config.subsample == "probabilistic":
-        return probabilistic_maxmin(graph, n_landmarks, k=config.knn_k, omega=config.omega, rng=rng, cover=cover)
-    return maxmin(graph, n_landmarks, rng=rng, candidates=candidates, cover=cover)
-
-
-def knn_scale_of(graph: EncounterGraph, k: int) -> float:
-    """s: median over distinct events (graph nodes) of the mean distance to their k
-    nearest other nodes."""
-    k = min(k, graph.n_nodes - 1)
-    distinct = replace(graph, multiplicity=np.ones_like(graph.multiplicity))
-    return float(np.median(knn_distances(distinct, k).mean(axis=1)))
-
-
 def share_landmarks(total: int, events: np.ndarray) -> np.ndarray:
     """Split ``total`` landmarks between regions in proportion to their events.
 
@@ -279,13 +259,6 @@ def share_landmarks(total: int, events: np.ndarray) -> np.ndarray:
     for i in np.argsort(-(raw - share), kind="stable")[: total - share.sum()]:
         share[i] += 1
     return np.maximum(share, 3)
-
-
-def _timed(timings: dict[str, float], stage: str, function, *args):
-    t0 = time.perf_counter()
-    value = function(*args)
-    timings[stage] += time.perf_counter() - t0
-    return value
 
 
 def _extrapolation_warnings(betti: dict[int, int | None]) -> list[str]:

@@ -99,7 +99,7 @@ class TopologicalMap:
     too_little_data: list[dict[str, int]]
     classifier: dict[str, Any]
     config: MapConfig
-    timings: dict[str, float]
+    timings: dict[str, float]  # seconds per stage; landmarks and persistence summed over the window tasks
     n_events: int
     n_agents: int
     hop_cost: tuple[float, str] = (0.0, "given")  # (h used, where it came from)

@@ -1,0 +1,130 @@
+"""Where the window tasks of one map run: this process's threads, or a Dask cluster.
+
+An engine has three verbs: ``share`` (a value every task reads: sent to the workers
+once), ``submit`` (a task whose arguments may be earlier tasks' futures: on Dask they
+stay where they were computed) and ``gather``.  Every task is a pure function of its
+arguments, so a map is the same bytes on every engine and any number of workers.
+
+:class:`ThreadEngine` (the default) runs tasks on one thread per numba thread, each
+limited to one numba thread so that the compiled kernels run serially without the GIL
+side by side.  :func:`dask_engine` runs them on a Dask cluster: an embedded
+``LocalCluster`` of ``workers`` processes, or the scheduler at an address; its
+workers get one numba thread each from a worker plugin
+(:class:`swarmtopo._dask_plugin.OneNumbaThread`), so workers started by hand (``dask worker
+ADDRESS``) are set up the same way, and every task limits its own thread too.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from concurrent.futures import Future, ThreadPoolExecutor
+from contextlib import contextmanager
+from typing import Any, Callable, Iterator
+
+from ..errors import SwarmtopoError
+
+CONNECT_TIMEOUT = "10s"
+"""How long a client waits for the scheduler at a given address."""
+WORKER_WAIT = 60.0
+"""Seconds a client waits for the first worker of an existing scheduler."""
+
+
+def one_numba_thread() -> None:
+    """Limit the calling thread's numba kernels to one thread (numba's setting is per thread)."""
+    import numba
+
+    numba.set_num_threads(1)
+
+
+class ThreadEngine:
+    """Tasks on ``threads`` threads of this process (numba.get_num_threads() by default)."""
+
+    def __init__(self, threads: int | None = None):
+        import numba
+
+        self.threads = threads or numba.get_num_threads()
+        self._pool = ThreadPoolExecutor(self.threads, initializer=one_numba_thread,
+                                        thread_name_prefix="swarmtopo-window")
+
+    def share(self, value: Any) -> Any:
+        return value
+
+    def submit(self, function: Callable, *args) -> Future:
+        # tasks are queued in submission order and a task's future arguments were all
+        # submitted before it, so waiting on them in a pool thread cannot deadlock
+        return self._pool.submit(lambda: function(*(a.result() if isinstance(a, Future) else a for a in args)))
+
+    def gather(self, futures: list[Future]) -> list:
+        return [f.result() for f in futures]
+
+    def close(self) -> None:
+        self._pool.shutdown(wait=True, cancel_futures=True)
+
+
+class DaskEngine:
+    """Tasks on a Dask ``client``'s workers; shared values are scattered to every worker once."""
+
+    def __init__(self, client):
+        self.client = client
+
+    def share(self, value: Any):
+        return self.client.scatter(value, broadcast=True, hash=False)
+
+    def submit(self, function: Callable, *args):
+        return self.client.submit(function, *args, pure=False)
+
+    def gather(self, futures: list) -> list:
+        return self.client.gather(futures)
+
+
+@contextmanager
+def dask_engine(workers: int | None = None, scheduler: Any = None) -> Iterator[DaskEngine]:
+    """A :class:`DaskEngine` on the scheduler at ``scheduler`` (an address, or a
+    ``distributed.Client`` the caller keeps), else on a new local cluster of ``workers``
+    processes of one thread each (closed on exit)."""
+    from distributed import Client, LocalCluster
+
+    from .._dask_plugin import OneNumbaThread
+
+    if scheduler is not None and not isinstance(scheduler, str):
+        scheduler.register_plugin(OneNumbaThread())
+        yield DaskEngine(scheduler)
+        return
+    if scheduler is not None:
+        try:
+            client = Client(scheduler, timeout=CONNECT_TIMEOUT)
+        except (OSError, ValueError, TypeError) as exc:
+            raise SwarmtopoError(f"cannot connect to the Dask scheduler at {scheduler!r} ({exc})") from None
+        try:
+            try:
+                client.wait_for_workers(1, timeout=WORKER_WAIT)
+            except TimeoutError:
+                raise SwarmtopoError(f"the Dask scheduler at {scheduler} has had no worker for "
+                                     f"{WORKER_WAIT:g} s; start some with: dask worker {scheduler}") from None
+            client.register_plugin(OneNumbaThread())
+            yield DaskEngine(client)
+        finally:
+            client.close()
+        return
+    with LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                      dashboard_address=":0", silence_logs=logging.CRITICAL,
+                      env={"NUMBA_NUM_THREADS": "1"}) as cluster, Client(cluster) as client:
+        client.register_plugin(OneNumbaThread())
+        yield DaskEngine(client)
+
+
+@contextmanager
+def engine_for(workers: int | None = None, scheduler: Any = None) -> Iterator[ThreadEngine | DaskEngine]:
+    """The engine of a map: Dask when ``workers`` or ``scheduler`` is given, else threads."""
+    if workers is None and scheduler is None:
+        engine = ThreadEngine()
+        try:
+            yield engine
+        finally:
+            engine.close()
+        return
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise SwarmtopoError(f"workers must be a whole number >= 1, got {workers!r}")
+    with dask_engine(workers, scheduler) as engine:
+        yield engine
