@@ -2,6 +2,7 @@
 during its start-up (while the modules load) said in one line like Ctrl-C later on."""
 
 import os
+import signal
 import sys
 
 INTERRUPTED = 130
@@ -20,7 +21,15 @@ def main() -> None:
     except SystemExit as exc:
         if exc.code == INTERRUPTED:  # Ctrl-C, already said in one line
             _exit_interrupted()
+        _finished()
         raise
+    _finished()
+
+
+def _finished() -> None:
+    """The command is done and said so: a Ctrl-C now, while the interpreter shuts
+    down, has nothing left to interrupt (it would end the process by SIGINT)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _exit_interrupted() -> None:

@@ -39,16 +39,13 @@ from ..io import GROUND_TRUTH_META_KEYS, read_arena, read_log, write_log
 from ..log import EncounterLog
 from ..topology.persistence import snr
 from ..pipeline import map_encounters
+from ..pipeline.engine import connected_client
 from ..pipeline.result import software_versions
 from ..viz.summary import window_json
 from ..sim import simulate
 from .grid import Job, flat_columns, job_map_config, job_simulation_args
 from .store import JOB_COLUMNS, ResultStore
 
-WORKER_WAIT = 120.0
-"""Seconds ``run_sweep`` waits for a first worker on an existing scheduler."""
-CONNECT_TIMEOUT = 10.0
-"""Seconds ``run_sweep`` tries to reach an existing scheduler."""
 POLL_SECONDS = 0.05
 """How often ``run_sweep`` looks for finished jobs and for Ctrl-C while it waits."""
 _STAGE_COLUMNS = {"graph": "t_graph", "landmarks": "t_landmarks", "persistence": "t_persistence",
@@ -339,19 +336,8 @@ def _dask_client(scheduler: str | None, workers: int | None, n_jobs: int):
     from distributed import Client, LocalCluster
 
     if scheduler is not None:
-        try:
-            client = Client(scheduler, timeout=CONNECT_TIMEOUT)
-        except (OSError, ValueError, TypeError) as exc:
-            raise SwarmtopoError(f"cannot connect to the Dask scheduler at {scheduler!r} ({exc})") from None
-        try:
-            try:
-                client.wait_for_workers(1, timeout=WORKER_WAIT)
-            except TimeoutError:
-                raise SwarmtopoError(f"the Dask scheduler at {scheduler} has had no worker for "
-                                     f"{WORKER_WAIT:g} s; start some with: dask worker {scheduler}") from None
+        with connected_client(scheduler) as client:  # workers started by hand: one numba thread each too
             yield client, len(client.nthreads())
-        finally:
-            client.close()
         return
     n_workers = min(workers or os.cpu_count() or 1, n_jobs)
     # One core per worker: numba's parallel kernels would otherwise start one thread per

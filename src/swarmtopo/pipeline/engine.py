@@ -24,9 +24,9 @@ from typing import Any, Callable, Iterator
 
 from ..errors import SwarmtopoError
 
-CONNECT_TIMEOUT = "10s"
-"""How long a client waits for the scheduler at a given address."""
-WORKER_WAIT = 60.0
+CONNECT_TIMEOUT = 10.0
+"""Seconds a client waits for the scheduler at a given address."""
+WORKER_WAIT = 120.0
 """Seconds a client waits for the first worker of an existing scheduler."""
 
 
@@ -35,6 +35,13 @@ def one_numba_thread() -> None:
     import numba
 
     numba.set_num_threads(1)
+
+
+def in_one_numba_thread(function: Callable, *args):
+    """``function(*args)`` with the calling thread limited to one numba thread (a Dask
+    worker's thread: whatever the worker's numba pool, the task's kernels run serially)."""
+    one_numba_thread()
+    return function(*args)
 
 
 class ThreadEngine:
@@ -72,10 +79,35 @@ class DaskEngine:
         return self.client.scatter(value, broadcast=True, hash=False)
 
     def submit(self, function: Callable, *args):
-        return self.client.submit(function, *args, pure=False)
+        return self.client.submit(in_one_numba_thread, function, *args, pure=False)
 
     def gather(self, futures: list) -> list:
         return self.client.gather(futures)
+
+
+@contextmanager
+def connected_client(address: str):
+    """A ``distributed.Client`` on the scheduler at ``address`` with at least one worker,
+    every worker set up by :class:`~swarmtopo._dask_plugin.OneNumbaThread`; closed on exit.
+    An unreachable scheduler, or one without workers, is a one-line SwarmtopoError."""
+    from distributed import Client
+
+    from .._dask_plugin import OneNumbaThread
+
+    try:
+        client = Client(address, timeout=CONNECT_TIMEOUT)
+    except (OSError, ValueError, TypeError) as exc:
+        raise SwarmtopoError(f"cannot connect to the Dask scheduler at {address!r} ({exc})") from None
+    try:
+        try:
+            client.wait_for_workers(1, timeout=WORKER_WAIT)
+        except TimeoutError:
+            raise SwarmtopoError(f"the Dask scheduler at {address} has had no worker for "
+                                 f"{WORKER_WAIT:g} s; start some with: dask worker {address}") from None
+        client.register_plugin(OneNumbaThread())
+        yield client
+    finally:
+        client.close()
 
 
 @contextmanager
@@ -92,24 +124,12 @@ def dask_engine(workers: int | None = None, scheduler: Any = None) -> Iterator[D
         yield DaskEngine(scheduler)
         return
     if scheduler is not None:
-        try:
-            client = Client(scheduler, timeout=CONNECT_TIMEOUT)
-        except (OSError, ValueError, TypeError) as exc:
-            raise SwarmtopoError(f"cannot connect to the Dask scheduler at {scheduler!r} ({exc})") from None
-        try:
-            try:
-                client.wait_for_workers(1, timeout=WORKER_WAIT)
-            except TimeoutError:
-                raise SwarmtopoError(f"the Dask scheduler at {scheduler} has had no worker for "
-                                     f"{WORKER_WAIT:g} s; start some with: dask worker {scheduler}") from None
-            client.register_plugin(OneNumbaThread())
+        with connected_client(scheduler) as client:
             yield DaskEngine(client)
-        finally:
-            client.close()
         return
     with LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                      dashboard_address=":0", silence_logs=logging.CRITICAL,
-                      env={"NUMBA_NUM_THREADS": "1"}) as cluster, Client(cluster) as client:
+                      dashboard_address=":0", silence_logs=logging.CRITICAL, env={"NUMBA_NUM_THREADS": "1"},
+                      preload=["swarmtopo._dask_plugin"]) as cluster, Client(cluster) as client:
         client.register_plugin(OneNumbaThread())
         yield DaskEngine(client)
 

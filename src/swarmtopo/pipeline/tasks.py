@@ -25,7 +25,6 @@ from ..metric.graph import EncounterGraph, WeightedChains
 from ..metric.landmarks import Landmarks, knn_distances, knn_maxmin, maxmin, probabilistic_maxmin, start_pool
 from ..topology.persistence import rips_persistence
 from .config import MapConfig
-from .engine import one_numba_thread
 from .regions import region_part
 from .result import RegionScales, WindowMap
 from .windows import in_band, usable_bands
@@ -63,7 +62,6 @@ def describe_part(part: EncounterGraph | None, span, bands: tuple[float, ...], c
     """s, the usable bands and their start pools' sizes of a region part (None: None)."""
     if part is None:
         return None
-    one_numba_thread()
     usable = tuple(usable_bands(part, span, bands))
     pools = tuple(len(start_pool(part, config.subsample, k=config.knn_k, q=config.knn_q,
                                  candidates=_band_candidates(part, span, band))) for band in usable)
@@ -75,7 +73,6 @@ def map_band(part: EncounterGraph, span, knn_scale: float, n_land: int | None, c
     """Landmarks and persistence of one region part in one window (span None: all its
     events), the landmarks drawn among the nodes of the window's middle ``band`` share
     from the start pool's node ``start``; with the seconds each took."""
-    one_numba_thread()
     t0 = time.perf_counter()
     t_lo, t_hi = _span_of(part, span)
     candidates = _band_candidates(part, span, band)
