@@ -43,6 +43,7 @@ import os
 import statistics
 import time
 from contextlib import contextmanager
+from functools import partial
 from pathlib import Path
 
 import numba
@@ -197,7 +198,7 @@ def growth(plot: Path) -> None:
     print("|---|---|---|---|---|---|---|")
     for n_events, agents in sizes:
         log = simulated_log(n_events, agents=agents)
-        tmap, wall, peak, _ = run_measured(lambda: map_encounters(log))
+        tmap, wall, peak, _ = run_measured(partial(map_encounters, log))
         windows = sum(len(r.windows) for r in tmap.regions)
         rows.append((tmap.n_events, wall, peak))
         print(f"| {tmap.n_events:,} | {log.n_agents:,} | {windows} | {tmap.timings['graph']:.1f} | {wall:.1f} | "

@@ -436,9 +436,54 @@ def test_bucket_searches_give_the_heap_and_scipy_distances_bit_for_bit(seed, hop
 def test_bucket_layout_hand_computed():
     from swarmtopo.metric._kernels import BUCKET_SPREAD, bucket_layout
 
-    assert bucket_layout(np.array([2.0, 3.0, 17.0])) == (1.0, 19)  # width: half the least; 17 / 1 + 2 buckets
+    # width: half the least weight; ceil(17 / 1) + 3 = 20 buckets needed, rounded up to 32
+    assert bucket_layout(np.array([2.0, 3.0, 17.0])) == (1.0, 32)
     spread = np.r_[1.0, np.full(9, 2 * BUCKET_SPREAD * 10 / 9)]  # mean over 32 x the least: heap
     assert bucket_layout(spread) == (0.0, 0)
+    assert bucket_layout(np.array([1e-300, 1e300])) == (0.0, 0)  # no overflow on the way to "heap"
+    assert bucket_layout(np.array([1e-310, 1.0])) == (0.0, 0)
+
+
+def test_buckets_never_wrap_onto_the_one_being_scanned():
+    """The longest edge relaxed from just below a bucket boundary lands the farthest
+    ahead: it must not land in the bucket being scanned (a path of two shortest edges
+    and a tuned one to just below a boundary, then the longest edge, against a detour)."""
+    from swarmtopo.metric import _kernels
+
+    least, longest, target = 8.176950185803168, 183.98137918057125, 192.15832936637443
+    tuned = target - 2 * least
+    while 2 * least + tuned != target:
+        tuned = np.nextafter(tuned, np.inf) if 2 * least + tuned < target else np.nextafter(tuned, 0)
+    edges = [(0, 1, least), (1, 2, least), (2, 3, tuned), (3, 4, longest), (0, 5, 100.0), (5, 6, 100.0),
+             (6, 4, 100.0), (4, 7, 100.0)]
+    i, j, w = (np.array(column) for column in zip(*edges))
+    indptr, indices, weights = _arrays(graph_from_edges(8, i, j, w))
+    nodes = np.array([0, 4, 7])
+    buckets = _kernels.rows_to_targets(indptr, indices, weights, nodes, nodes)
+    assert buckets.tolist() == [[0.0, 300.0, 400.0], [300.0, 0.0, 100.0], [400.0, 100.0, 0.0]]
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_buckets_agree_with_the_heap_on_weights_on_a_grid(seed):
+    """Weights that are multiples of one step (times on 0.1 s ticks) put many keys on
+    bucket boundaries: buckets and heap still agree bit for bit."""
+    from swarmtopo.metric import _kernels
+
+    rng = np.random.default_rng(seed)
+    for _ in range(60):
+        n = int(rng.integers(50, 300))
+        i = np.r_[rng.integers(0, n, 3 * n), np.arange(n - 1)]
+        j = np.r_[rng.integers(0, n, 3 * n), np.arange(1, n)]
+        keep = i != j
+        step = rng.choice([0.1, 0.15, 1 / 3, 0.7])
+        low = int(rng.integers(1, 5))
+        w = rng.integers(low, low + int(rng.integers(1, 40)), keep.sum()) * step
+        g = graph_from_edges(n, i[keep], j[keep], w)  # duplicate pairs add up: still positive weights
+        indptr, indices, weights = _arrays(g)
+        assert _kernels.bucket_layout(weights)[1] > 0
+        nodes = rng.choice(n, min(40, n), replace=False)
+        assert np.array_equal(_kernels.rows_to_targets(indptr, indices, weights, nodes, nodes),
+                              _kernels.rows_to_targets(indptr, indices, weights, nodes, nodes, buckets=False))
 
 
 @pytest.mark.parametrize("method", sorted(SUBSAMPLERS))

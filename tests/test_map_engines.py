@@ -83,3 +83,42 @@ def test_an_unreachable_scheduler_is_one_line(one_hole_log, tmp_path):
     assert "cannot connect to the Dask scheduler" in proc.stderr
     assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
     assert not (tmp_path / "map").exists()
+
+
+def test_a_region_without_a_picture_takes_no_draw_from_the_stream(two_rooms_log):
+    """The MDS draws from the map's stream only when it runs (a region's chosen window
+    with more landmarks than the picture's dimension), as the map always did: with 3
+    landmarks per room no picture is drawn, so the second room's landmark starts are the
+    same with or without pictures; with 4, the picture's draw moves them."""
+    log = read_log(two_rooms_log.folder)
+    for per_room, same in ((3, True), (4, False)):
+        maps = [map_encounters(log, MapConfig(landmarks=2 * per_room, window_scales=(1.0,), max_windows=3,
+                                              embed_dim=dim, cycles=False)) for dim in (3, 0)]
+        assert [len(r.regions) for r in maps] == [2, 2]
+        starts = [[w.landmarks.params["start"] for w in tmap.regions[1].windows] for tmap in maps]
+        assert (starts[0] == starts[1]) == same, starts
+
+
+@pytest.mark.slow
+def test_ctrl_c_during_a_map_on_a_local_cluster_is_one_line(two_rooms_log, tmp_path):
+    """Ctrl-C as a terminal sends it (to the whole process group, the cluster's workers
+    included) while the windows run on a local cluster: one line, exit 130, nothing written."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    for delay in (4.0, 6.0):
+        out = tmp_path / f"map-{delay}"
+        proc = subprocess.Popen([sys.executable, "-m", "swarmtopo", "map", str(two_rooms_log.folder), "--out",
+                                 str(out), "--workers", "2"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                text=True, start_new_session=True)
+        time.sleep(delay)
+        os.killpg(proc.pid, signal.SIGINT)
+        _, stderr = proc.communicate(timeout=120)
+        if proc.returncode == 0:  # the map finished first
+            continue
+        assert proc.returncode == 130, stderr
+        assert len(stderr.strip().splitlines()) == 1 and stderr.startswith("interrupted: no"), stderr
+        assert not out.exists()

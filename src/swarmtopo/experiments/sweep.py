@@ -22,7 +22,6 @@ import os
 import signal
 import socket
 import tempfile
-import threading
 import time
 from collections import Counter
 from contextlib import contextmanager
@@ -39,15 +38,13 @@ from ..io import GROUND_TRUTH_META_KEYS, read_arena, read_log, write_log
 from ..log import EncounterLog
 from ..topology.persistence import snr
 from ..pipeline import map_encounters
-from ..pipeline.engine import connected_client
+from ..pipeline.engine import POLL_SECONDS, connected_client, deferred_interrupt
 from ..pipeline.result import software_versions
 from ..viz.summary import window_json
 from ..sim import simulate
 from .grid import Job, flat_columns, job_map_config, job_simulation_args
 from .store import JOB_COLUMNS, ResultStore
 
-POLL_SECONDS = 0.05
-"""How often ``run_sweep`` looks for finished jobs and for Ctrl-C while it waits."""
 _STAGE_COLUMNS = {"graph": "t_graph", "landmarks": "t_landmarks", "persistence": "t_persistence",
                   "classify": "t_classify"}
 
@@ -287,7 +284,7 @@ def run_sweep(
             say(0, len(pending), 0)
             finished = as_completed(list(futures.values()))
             try:
-                with _deferred_interrupt() as interrupted:
+                with deferred_interrupt() as interrupted:
                     while not finished.is_empty():
                         if interrupted():
                             raise KeyboardInterrupt
@@ -307,27 +304,6 @@ def run_sweep(
         return SweepSummary(total=len(unique), skipped=len(unique) - len(pending), run=run,
                             failed=sum(errors.values()), seconds=time.perf_counter() - start,
                             workers=n_workers, errors=dict(errors))
-
-
-@contextmanager
-def _deferred_interrupt():
-    """Turn SIGINT into a flag the caller polls (yields ``interrupted() -> bool``).
-
-    A KeyboardInterrupt raised inside one of distributed's blocking calls makes its
-    event loop log a traceback (a NameError in ``distributed.utils.sync``'s cancel
-    callback, seen with distributed 2026.8); raised by the caller between calls, it
-    leaves distributed in a clean state.  Outside the main thread signals cannot be
-    caught, so nothing changes there.
-    """
-    if threading.current_thread() is not threading.main_thread():
-        yield lambda: False
-        return
-    flag = threading.Event()
-    previous = signal.signal(signal.SIGINT, lambda signum, frame: flag.set())
-    try:
-        yield flag.is_set
-    finally:
-        signal.signal(signal.SIGINT, previous)
 
 
 @contextmanager

@@ -22,6 +22,8 @@ split over sources changes nothing but the time.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import get_num_threads, njit, prange
 
@@ -260,16 +262,20 @@ def bucket_layout(weights: np.ndarray) -> tuple[float, int]:
     (all > 0), or (0, 0) when the heap search is the better choice.
 
     The width is half the least weight: a node settled at d relaxes its neighbours to
-    at least d + 2 x width, two buckets on, so every node left in the lowest non-empty
-    bucket is already final, with a whole bucket of margin for rounding."""
+    at least d + 2 x width, at least one whole bucket on even after rounding, so every
+    node left in the lowest non-empty bucket is already final.  The live entries then
+    span at most ceil(longest / width) + 2 consecutive buckets; the circular array holds
+    one more than that, rounded up to a power of two (its index is a bit mask)."""
     if not len(weights):
         return 0.0, 0
-    least = float(weights.min())
-    width = least / 2
-    n_buckets = int(float(weights.max()) / width) + 2
-    if float(weights.mean()) > BUCKET_SPREAD * least or n_buckets > MAX_BUCKETS:
+    least, longest = float(weights.min()), float(weights.max())
+    if not float(weights.mean()) <= BUCKET_SPREAD * least:  # also catches overflow to inf
         return 0.0, 0
-    return width, n_buckets
+    width = least / 2
+    needed = math.ceil(longest / width) + 3
+    if needed > MAX_BUCKETS:
+        return 0.0, 0
+    return width, 1 << (needed - 1).bit_length()
 
 
 @njit(cache=True, nogil=True)
@@ -277,7 +283,7 @@ def settle_buckets(indptr, indices, weights, source, is_target, n_targets, width
                    dist, touched, head, entry_next, entry_node, entry_key, found_node, found_dist):
     """Dijkstra from ``source`` until the ``n_targets`` nodes with ``is_target`` are settled,
     with a circular bucket queue (Dial's) of ``n_buckets`` buckets ``width`` wide
-    (:func:`bucket_layout`) instead of a heap.
+    (:func:`bucket_layout`: a power of two) instead of a heap.
 
     Each bucket is a linked list of (node, key) entries, one per strict improvement (a
     lazy queue, as :func:`settle`'s heap).  Every node in the lowest non-empty bucket
@@ -289,6 +295,8 @@ def settle_buckets(indptr, indices, weights, source, is_target, n_targets, width
     entry and exit and entries of length nnz + 1.  Returns the number of found nodes.
     """
     n_found = 0
+    inverse = 1.0 / width
+    mask = n_buckets - 1
     dist[source] = 0.0
     touched[0] = source
     n_touched = 1
@@ -300,7 +308,7 @@ def settle_buckets(indptr, indices, weights, source, is_target, n_targets, width
     live = 1
     bucket = 0
     while live > 0:
-        slot = bucket % n_buckets
+        slot = bucket & mask
         e = head[slot]
         if e < 0:
             bucket += 1
@@ -325,7 +333,7 @@ def settle_buckets(indptr, indices, weights, source, is_target, n_targets, width
                     touched[n_touched] = v
                     n_touched += 1
                 dist[v] = nd
-                b = int(nd / width) % n_buckets
+                b = np.int64(nd * inverse) & mask
                 entry_node[n_entries] = v
                 entry_key[n_entries] = nd
                 entry_next[n_entries] = head[b]

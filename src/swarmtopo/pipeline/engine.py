@@ -18,6 +18,9 @@ from __future__ import annotations
 
 import logging
 import os
+import signal
+import threading
+import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import contextmanager
 from typing import Any, Callable, Iterator
@@ -28,6 +31,8 @@ CONNECT_TIMEOUT = 10.0
 """Seconds a client waits for the scheduler at a given address."""
 WORKER_WAIT = 120.0
 """Seconds a client waits for the first worker of an existing scheduler."""
+POLL_SECONDS = 0.05
+"""How often a client waiting on Dask tasks looks for Ctrl-C (and for finished tasks)."""
 
 
 def one_numba_thread() -> None:
@@ -65,8 +70,10 @@ class ThreadEngine:
     def gather(self, futures: list[Future]) -> list:
         return [f.result() for f in futures]
 
-    def close(self) -> None:
-        self._pool.shutdown(wait=True, cancel_futures=True)
+    def close(self, wait: bool = True) -> None:
+        """Shut the threads down; ``wait=False`` (after an error or Ctrl-C) returns at once,
+        the running tasks ending in the background."""
+        self._pool.shutdown(wait=wait, cancel_futures=True)
 
 
 class DaskEngine:
@@ -82,6 +89,14 @@ class DaskEngine:
         return self.client.submit(in_one_numba_thread, function, *args, pure=False)
 
     def gather(self, futures: list) -> list:
+        """The futures' results; Ctrl-C cancels them and raises KeyboardInterrupt between
+        Dask's calls, never inside one (see :func:`deferred_interrupt`)."""
+        with deferred_interrupt() as interrupted:
+            while not all(future.done() for future in futures):
+                if interrupted():
+                    self.client.cancel(futures)
+                    raise KeyboardInterrupt
+                time.sleep(POLL_SECONDS)
         return self.client.gather(futures)
 
 
@@ -141,10 +156,33 @@ def engine_for(workers: int | None = None, scheduler: Any = None) -> Iterator[Th
         engine = ThreadEngine()
         try:
             yield engine
-        finally:
-            engine.close()
+        except BaseException:
+            engine.close(wait=False)
+            raise
+        engine.close()
         return
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise SwarmtopoError(f"workers must be a whole number >= 1, got {workers!r}")
     with dask_engine(workers, scheduler) as engine:
         yield engine
+
+
+@contextmanager
+def deferred_interrupt():
+    """Turn SIGINT into a flag the caller polls (yields ``interrupted() -> bool``).
+
+    A KeyboardInterrupt raised inside one of distributed's blocking calls makes its
+    event loop log a traceback (a NameError in ``distributed.utils.sync``'s cancel
+    callback, seen with distributed 2026.8); raised by the caller between calls, it
+    leaves distributed in a clean state.  Outside the main thread signals cannot be
+    caught, so nothing changes there.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield lambda: False
+        return
+    flag = threading.Event()
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: flag.set())
+    try:
+        yield flag.is_set
+    finally:
+        signal.signal(signal.SIGINT, previous)

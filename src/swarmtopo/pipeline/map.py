@@ -37,7 +37,7 @@ from ..topology.persistence import Diagram, rips_persistence
 from .config import MapConfig
 from .engine import engine_for
 from .regions import MIN_REGION_AGENTS, split_regions
-from .result import RegionMap, TopologicalMap, WindowMap, software_versions
+from .result import RegionMap, RegionScales, TopologicalMap, WindowMap, software_versions
 from .settings import Settings, resolve
 from .tasks import AUTO_COVER_FACTOR, cut_window, describe_part, map_band, window_part
 from .windows import silence_warnings
@@ -106,9 +106,12 @@ def map_encounters(
     shares = (share_landmarks(config.landmarks, events_per_region) if config.landmarks
               else [None] * len(split.regions))
     with engine_for(workers, scheduler) as engine:
-        mapped = _map_windows(engine, chains, graph, split, log, config, settings, shares, rng, timings, say)
-    regions = [_read_region(comp, split, windows, notes, reader, config, mds_seed, timings, say)
-               for comp, (windows, notes, mds_seed) in zip(split.regions, mapped)]
+        plans = _plan_windows(engine, chains, graph, split, log, config, settings, say)
+        say("persistence")
+        regions = []
+        for comp, (plan, notes), n_land in zip(split.regions, plans, shares):
+            windows = _map_region(engine, plan, n_land, config, rng, timings)
+            regions.append(_read_region(comp, split, windows, notes, reader, config, rng, timings, say))
 
     betti: dict[int, int | None] = {0: len(regions)}
     confidence: dict[int, float | None] = {0: shipped_beta0_model().confidence(split.beta0)}
@@ -139,15 +142,11 @@ def map_encounters(
     )
 
 
-def _map_windows(engine, chains, graph, split, log, config: MapConfig, settings: Settings, shares, rng, timings,
-                 say) -> list[tuple[list[WindowMap], list[str], int | None]]:
-    """Every region's windows, each mapped once per usable landmark band (the region's
-    whole log instead when no window holds enough of it), with notes on what was
-    skipped and the region's MDS seed, as tasks on ``engine``.
-
-    The random draws -- each mapped band's landmark start, then the region's MDS seed,
-    region by region -- are made here, in that order, from the map's one stream, so the
-    tasks' order of completion changes nothing."""
+def _plan_windows(engine, chains, graph, split, log, config: MapConfig, settings: Settings,
+                  say) -> list[tuple[list, list[str]]]:
+    """Per region: the (part, span, PartInfo) of every window that holds enough of it (its
+    whole log instead when none does), the parts left on the engine, and notes on what
+    was skipped.  Every window's graph is cut once and shared by the regions."""
     say("landmarks")
     bands = settings.landmark_bands
     shared_chains, shared_log = engine.share(chains), engine.share(log)
@@ -159,12 +158,10 @@ def _map_windows(engine, chains, graph, split, log, config: MapConfig, settings:
                       for cut in cuts])
         infos.append([engine.submit(describe_part, part, span, bands, config)
                       for part, span in zip(parts[-1], settings.spans)])
-    described = [engine.gather(region_infos) for region_infos in infos]
-
-    plans = []  # per region: [(part, span, info)], notes
-    for comp, region_parts, region_infos in zip(split.regions, parts, described):
-        plan = [(part, span, info) for part, span, info in zip(region_parts, settings.spans, region_infos)
-                if info is not None]
+    plans = []
+    for comp, region_parts, region_infos in zip(split.regions, parts, infos):
+        plan = [(part, span, info) for part, span, info in zip(region_parts, settings.spans,
+                                                                 engine.gather(region_infos)) if info is not None]
         notes = []
         if not plan:  # no window holds enough of this region: map its whole log instead
             whole = engine.share(graph.subgraph(np.flatnonzero(split.labels == comp)))
@@ -180,25 +177,24 @@ def _map_windows(engine, chains, graph, split, log, config: MapConfig, settings:
                          f"of their time span a landmark band draws from (a quiet stretch of the log): {quiet}; "
                          f"they were mapped without that band")
         plans.append((plan, notes))
+    return plans
 
-    say("persistence")
-    submitted = []
-    for (plan, notes), n_land in zip(plans, shares):
-        tasks = [engine.submit(map_band, part, span, info.knn_scale, n_land, config, band, int(rng.integers(pool)))
-                 for part, span, info in plan for band, pool in zip(info.bands, info.pool_sizes)]
-        mds_seed = int(rng.integers(2**31 - 1)) if config.embed_dim else None
-        submitted.append((tasks, notes, mds_seed))
-    mapped = []
-    for tasks, notes, mds_seed in submitted:
-        results = engine.gather(tasks)
-        timings["landmarks"] += sum(r[1] for r in results)
-        timings["persistence"] += sum(r[2] for r in results)
-        mapped.append(([r[0] for r in results], notes, mds_seed))
-    return mapped
+
+def _map_region(engine, plan, n_land: int | None, config: MapConfig, rng, timings) -> list[WindowMap]:
+    """A region's planned windows, each mapped once per usable band, as tasks on
+    ``engine``.  Each task's landmark start is drawn here, in window then band order,
+    from the map's one stream (as the region's MDS draws from it next), so the order in
+    which tasks finish changes nothing."""
+    tasks = [engine.submit(map_band, part, span, info.knn_scale, n_land, config, band, int(rng.integers(pool)))
+             for part, span, info in plan for band, pool in zip(info.bands, info.pool_sizes)]
+    results = engine.gather(tasks)
+    timings["landmarks"] += sum(seconds for _, seconds, _ in results)
+    timings["persistence"] += sum(seconds for _, _, seconds in results)
+    return [window for window, _, _ in results]
 
 
 def _read_region(comp, split, windows: list[WindowMap], notes: list[str], reader: BettiReader, config: MapConfig,
-                 mds_seed: int | None, timings, say) -> RegionMap:
+                 rng, timings, say) -> RegionMap:
     """The reader's Betti numbers over the region's windows, its picture and its loops."""
     say("classify")
     t0 = time.perf_counter()
@@ -213,7 +209,7 @@ def _read_region(comp, split, windows: list[WindowMap], notes: list[str], reader
 
     say("embedding")
     t0 = time.perf_counter()
-    embedding = (mds(chosen.landmarks.distances, dim=config.embed_dim, rng=mds_seed)
+    embedding = (mds(chosen.landmarks.distances, dim=config.embed_dim, rng=rng)
                  if config.embed_dim and len(chosen.landmarks.nodes) > config.embed_dim else None)
     timings["embedding"] += time.perf_counter() - t0
     region = RegionMap(
