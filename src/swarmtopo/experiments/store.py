@@ -15,8 +15,8 @@ Tables
     region, largest first), sizes (``n_events, n_agents, n_regions, n_landmarks``),
     stage timings in seconds (``t_simulate, t_graph, t_landmarks, t_persistence,
     t_classify, t_total``; landmarks and persistence summed over the map's window
-    tasks, which run side by side when a worker has more than one thread), ``versions`` JSON (software versions, and the classifier's
-    name and Theta), ``worker`` (host:pid), ``finished_at`` (UTC) and ``error``: the
+    tasks, which run side by side when a worker has more than one thread),
+    ``versions`` JSON (software versions, and the classifier's name and Theta), ``worker`` (host:pid), ``finished_at`` (UTC) and ``error``: the
     one-line message of a job that failed with a user-level error (too little data,
     holes that do not fit), whose estimates are then NULL.
 ``sweep_jobs``

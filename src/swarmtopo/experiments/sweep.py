@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import logging
 import os
-import signal
 import socket
 import tempfile
 import time
@@ -319,24 +318,16 @@ def _dask_client(scheduler: str | None, workers: int | None, n_jobs: int):
     # One core per worker: numba's parallel kernels would otherwise start one thread per
     # core in every worker (BLAS / OpenMP threads are already 1 under Dask's nanny).  The
     # scheduler's HTTP server takes any free port (8787 may be another cluster's).  The
-    # workers preload this module (its imports take seconds) and run its dask_setup.
+    # workers preload this module (its imports take seconds) and swarmtopo._dask_plugin
+    # (its dask_setup: they ignore SIGINT, which the client alone handles).
     # Only CRITICAL logs: a job's own exception reaches the client through its future,
     # and after Ctrl-C a worker may log an ERROR with a traceback ("failed to communicate
     # with scheduler during heartbeat") while the cluster it belongs to shuts down.
     with LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=":0",
-                      silence_logs=logging.CRITICAL, env={"NUMBA_NUM_THREADS": "1"}, preload=[__name__]) as cluster:
+                      silence_logs=logging.CRITICAL, env={"NUMBA_NUM_THREADS": "1"},
+                      preload=["swarmtopo._dask_plugin", __name__]) as cluster:
         with Client(cluster) as client:
             yield client, n_workers
-
-
-def dask_setup(worker) -> None:
-    """Dask preload hook of the local cluster's workers: ignore SIGINT.
-
-    Ctrl-C on a terminal reaches every process of the foreground group, workers
-    included; the client alone handles it (cancels the tasks, closes the cluster),
-    so the workers must not die of it first with tracebacks of their own.
-    """
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 @lru_cache(maxsize=8)

@@ -10,7 +10,8 @@ nodes against 41 ms here with two threads, benchmarks/bench_landmarks.py), and
 :func:`lower_distances` stops at every node it cannot improve (maxmin picks).
 Landmark-to-landmark rows search with a bucket queue instead of the heap when every
 edge weighs at least a fair share of the mean (:func:`settle_buckets`: the per-hop
-cost h makes it so), with the same distances bit for bit, 2x faster.
+cost h makes it so), with the same distances bit for bit, 2.5x faster
+(benchmarks/bench_map.py).
 
 Drivers run parallel over sources on numba's threads, or serially without the GIL in
 a thread limited to one numba thread, so that the pipeline's window tasks can run

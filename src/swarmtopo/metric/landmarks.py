@@ -324,12 +324,11 @@ def start_pool(graph, method: str, *, k: int = 10, q: float = 0.9,
     """The nodes l_1 is drawn from, in index order: ``candidates`` (maxmin; None: every
     node), the kept set V (knn) or every node (probabilistic).  A subsampler called with
     ``start=i`` starts at the pool's i-th node, as with a drawn ``rng.integers(len(pool))``."""
-    arrays = _GraphArrays.of(graph)
     if method == "knn":
-        return np.flatnonzero(_knn_kept(arrays, positive_int("k", k), q)[0])
+        return np.flatnonzero(_knn_kept(_GraphArrays.of(graph), positive_int("k", k), q)[0])
     if method == "maxmin" and candidates is not None:
         return np.flatnonzero(candidates)
-    return np.arange(arrays.n)
+    return np.arange(graph.adjacency.shape[0])
 
 
 def _start_node(candidates: np.ndarray, rng: np.random.Generator, rank: int | None) -> int:
