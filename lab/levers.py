@@ -119,6 +119,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import threading
 import time
 from concurrent.futures import ProcessPoolExecutor
 
@@ -445,7 +446,7 @@ def _padded(log, seed, factor):
     band, with bands): paths may leave the
     window in time, so the events at its edges are not outliers of a cut chain."""
     original_map, original_subsample = P.map_band, T.subsample
-    current = {"span": None, "band": 1.0}
+    current = threading.local()  # windows map on parallel threads: each its own span and band
 
     def build(log_, metric, *, window=None, **options):
         if window is not None and None not in window:
@@ -454,13 +455,16 @@ def _padded(log, seed, factor):
         return G.build_graph(log_, metric, window=window, **options)
 
     def map_band(part, span, knn_scale, n_land, config, band, start):
-        current["span"], current["band"] = span, band
-        return original_map(part, span, knn_scale, n_land, config, band, start)
+        current.span, current.band = span, band
+        try:
+            return original_map(part, span, knn_scale, n_land, config, band, start)
+        finally:
+            current.span = None
 
     def subsample(graph, config, n_landmarks, start, candidates=None, cover=None):
-        if current["span"] is None:
+        if getattr(current, "span", None) is None:
             return original_subsample(graph, config, n_landmarks, start, candidates, cover)
-        inside = in_band(graph.node_times(), current["span"], current["band"])
+        inside = in_band(graph.node_times(), current.span, current.band)
         # the start was drawn among the padded window's band: fold it into the window's own
         return L.maxmin(graph, n_landmarks, start=start % int(inside.sum()), cover=cover, candidates=inside)
 
