@@ -64,7 +64,7 @@ def main() -> None:
     jobs = reporting_jobs(per_cell, pipelines={"contact-trace": TRACE_PIPELINE})
     grid = planning_jobs(reading="contact-trace") if args.planning else []
     start = time.perf_counter()
-    summary = run_sweep(jobs + grid, args.store, workers=args.workers)
+    summary = run_sweep(jobs + grid, args.store, workers=args.workers, keep="windows")
     print(f"{len(jobs)} contact-trace maps ({per_cell} per cell) and {len(grid)} of the planning grid, "
           f"{summary.run} run in {(time.perf_counter() - start) / 60:.1f} min on {summary.workers} Dask workers")
     rows = job_rows(args.store, jobs)  # each job's stored diagrams, read by each classifier (whatever the job ran)

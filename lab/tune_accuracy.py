@@ -135,7 +135,7 @@ def main() -> None:
         # each classifier's grid is read as its candidate reads the tuning cases (log folder or contact trace)
         grids = {n: calibration_jobs(reading=map_input(CANDIDATES[SHIPPED[n][0]])) for n in shipping}
         every = [j for js in (*jobs.values(), *grids.values()) for j in js]
-        summary = run_sweep(every, args.store, scheduler=args.scheduler, workers=args.workers,
+        summary = run_sweep(every, args.store, scheduler=args.scheduler, workers=args.workers, keep="windows",
                             progress=lambda done, total, failed: print(f"\r{done}/{total} jobs", end="", flush=True))
         print(f"\n{summary}")
         stored = {row["key"]: row for row in job_rows(args.store, every)}
@@ -211,7 +211,7 @@ def _refit_regions_exponent(args) -> None:
                                cells=several)
                 for n in shipping}
         every = [j for js in jobs.values() for j in js]
-        summary = run_sweep(every, args.store, scheduler=args.scheduler, workers=args.workers,
+        summary = run_sweep(every, args.store, scheduler=args.scheduler, workers=args.workers, keep="windows",
                             progress=lambda done, total, failed: print(f"\r{done}/{total} jobs", end="", flush=True))
         print(f"\n{summary}")
         stored = {row["key"]: row for row in job_rows(args.store, every)}

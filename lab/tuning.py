@@ -72,7 +72,7 @@ def maps_from_rows(rows: Sequence[dict[str, Any]], cell_of) -> list[TuningMap]:
 
     ``cell_of(config) -> str`` names each row's cell.
     """
-    return [TuningMap(tuple(tuple(Diagram.from_json(w["diagram"]) for w in region["windows"])
+    return [TuningMap(tuple(tuple(w["diagram"] for w in region["windows"])
                             for region in row["diagrams"]),
                       int(row["est_betti0"]), int(row["true_betti0"]), int(row["true_betti1"]), cell_of(row["config"]),
                       tuple(windows_span(region["windows"]) for region in row["diagrams"]))

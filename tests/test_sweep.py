@@ -22,7 +22,8 @@ import pytest
 
 from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.experiments.grid import PARAMS, STORE_INT_MAX, expand_grid, read_sweep
-from swarmtopo.experiments.store import RUN_COLUMNS, ResultStore, read_jobs
+from swarmtopo.experiments.store import RUN_COLUMNS, ResultStore, decode_regions, read_jobs
+from swarmtopo.topology.persistence import Diagram
 from swarmtopo.experiments.sweep import job_map_config, run_job, run_sweep
 from swarmtopo.pipeline import MapConfig
 
@@ -48,7 +49,11 @@ from conftest import stop_group, run_cli  # noqa: E402  (the CLI in-process)
 
 
 def result_columns(row):
-    return {k: v for k, v in row.items() if k not in RUN_COLUMNS}
+    """The row's result columns as plain JSON data (diagrams decoded, Diagram objects as JSON)."""
+    out = {k: v for k, v in row.items() if k not in RUN_COLUMNS}
+    if isinstance(out.get("diagrams"), bytes):
+        out["diagrams"] = decode_regions(out["diagrams"])
+    return json.loads(json.dumps(out, default=lambda x: x.to_json() if isinstance(x, Diagram) else str(x)))
 
 
 @pytest.fixture(scope="module")
@@ -62,7 +67,7 @@ def sweep_file(tmp_path_factory):
 def reference(sweep_file):
     """key -> result columns of every job's row, computed here by run_job (JSON-normalised like the store's)."""
     rows = [run_job(job) for job in read_sweep(sweep_file).jobs]
-    return {row["key"]: result_columns(json.loads(json.dumps(row, default=str))) for row in rows}
+    return {row["key"]: result_columns(row) for row in rows}
 
 
 def assert_store_matches(store, reference):
@@ -257,8 +262,7 @@ def test_every_integer_key_is_bounded_by_its_store_column(tmp_path):
     # the bound itself is stored (the job's row: holes that do not fit)
     row = run_job(expand_grid({"arena": {"holes": STORE_INT_MAX}}).jobs[0])
     assert row["error"].startswith(f"cannot place {STORE_INT_MAX} holes")
-    with ResultStore(tmp_path / "s.duckdb") as store:
-        assert store.insert(row)
+    assert ResultStore(tmp_path / "s.duckdb").write([row])
     assert [r["holes"] for r in read_jobs(tmp_path / "s.duckdb")] == [STORE_INT_MAX]
 
 
@@ -326,7 +330,7 @@ def test_run_job_row_is_deterministic_and_consistent():
     assert row["n_agents"] == 200 and row["n_regions"] == 1 and row["n_landmarks"] == 200
     # the union diagram's H1 lengths, decreasing, are the regions' H1 bars
     lengths = np.array(row["lengths_h1"])
-    bars = np.array([d - b for r in row["diagrams"] for b, d in r["diagram"]["1"]])
+    bars = np.concatenate([r["diagram"].lengths(1) for r in decode_regions(row["diagrams"])])
     assert np.array_equal(lengths, np.sort(bars)[::-1])
     # paper's SNR with beta_1 = 2: mean square of the 2 longest over mean square of the rest
     assert row["snr_h1"] == pytest.approx(np.mean(lengths[:2] ** 2) / np.mean(lengths[2:] ** 2), rel=1e-12)
@@ -343,11 +347,10 @@ def test_user_errors_are_rows_with_null_estimates(tmp_path):
     assert row["error"] == "the log has 0 event(s); at least 2 encounters are needed to build a map"
     assert row["est_betti0"] is None and row["lengths_h1"] is None and row["snr_h1"] is None
     assert row["true_betti1"] == 1 and row["n_events"] == 0 and row["t_simulate"] > 0
-    with ResultStore(tmp_path / "s.duckdb") as store:
-        assert store.insert(row)
-        assert not store.insert(row)  # a key is stored once
+    store = ResultStore(tmp_path / "s.duckdb")
+    assert store.write([row]) and store.write([row])  # a key is stored once: the second write replaces it
     (stored,) = read_jobs(tmp_path / "s.duckdb")
-    assert result_columns(stored) == result_columns(json.loads(json.dumps(row, default=str)))
+    assert stored["status"] == "error" and result_columns(stored) == result_columns(row)
 
 
 def test_a_job_shared_by_two_sweeps_is_stored_once_and_read_by_both(tmp_path):
@@ -355,9 +358,7 @@ def test_a_job_shared_by_two_sweeps_is_stored_once_and_read_by_both(tmp_path):
     a = expand_grid({**base, "sweep": {"name": "a", "replicates": 2}}).jobs
     b = expand_grid({**base, "sweep": {"name": "b", "replicates": 3}}).jobs  # replicates 0, 1 are a's jobs
     store = tmp_path / "s.duckdb"
-    with ResultStore(store) as db:
-        for job in a + b:
-            db.insert(run_job(job))
+    ResultStore(store).write([run_job(job) for job in {job.key: job for job in a + b}.values()])
     # everything is stored already: no cluster is started, every job is skipped
     summary = run_sweep(a + b, store)
     assert (summary.total, summary.skipped, summary.run, summary.workers) == (3, 3, 0, 0)
@@ -377,7 +378,7 @@ def test_foreign_files_are_refused_as_stores(tmp_path):
     with duckdb.connect(str(tmp_path / "other.duckdb")) as db:
         db.execute("CREATE TABLE sweep_jobs (sweep TEXT, key TEXT)")
     for open_store in (ResultStore, read_jobs):
-        with pytest.raises(SwarmtopoError, match="missing columns: sweep, replicate.*unknown: answer"):
+        with pytest.raises(SwarmtopoError, match="a result store of an earlier swarmtopo version"):
             open_store(tmp_path / "other.duckdb")
     # a store of another version is read for the columns asked, if it has them
     with duckdb.connect(str(tmp_path / "other.duckdb")) as db:
@@ -398,7 +399,7 @@ def test_one_local_worker_and_two_scheduler_workers_give_identical_tables(tmp_pa
     assert (one.workers, two.workers) == (1, 2)
     failed = sum(r["error"] is not None for r in reference.values())
     assert 0 < failed < 8  # error rows are results too: stored, compared, never rerun
-    assert (one.run, one.skipped, one.failed) == (8, 0, failed)
+    assert (one.run, one.skipped, one.failed) == (8, 0, {"error": failed})
     assert_store_matches(tmp_path / "one.duckdb", reference)
     assert_store_matches(tmp_path / "two.duckdb", reference)
     again = run_sweep(jobs, tmp_path / "two.duckdb", scheduler=dask_cluster)
@@ -408,7 +409,8 @@ def test_one_local_worker_and_two_scheduler_workers_give_identical_tables(tmp_pa
 
 
 def _interrupt_after_first_row(sweep_file, store, sig, *extra):
-    """Run `swarmtopo sweep`, send ``sig`` once the first row is written; (process, rest of stderr)."""
+    """Run `swarmtopo sweep`, send ``sig`` once the first row is in the store (read by this
+    process while the sweep writes to it); (process, rest of stderr)."""
     proc = subprocess.Popen([sys.executable, "-m", "swarmtopo", "sweep", str(sweep_file), "--store", str(store),
                              "--verbose", *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True)
@@ -418,6 +420,8 @@ def _interrupt_after_first_row(sweep_file, store, sig, *extra):
         for line in proc.stderr:  # --verbose: one line per finished job
             if line.startswith("1/8 jobs done"):
                 break
+        while not store.exists() or not read_jobs(store, columns=("key",)):  # written within FLUSH_SECONDS
+            time.sleep(0.1)
         os.kill(proc.pid, sig)
         _, rest = proc.communicate(timeout=60)
     except BaseException:
@@ -470,7 +474,7 @@ def test_sigkill_loses_no_written_row_and_a_rerun_finishes_exactly_the_rest(tmp_
     rerun = run_cli("sweep", sweep_file, "--store", store, "--scheduler", dask_cluster)
     assert rerun.returncode == 0, rerun.stderr
     assert f"8 jobs: {8 - len(done)} run" in rerun.stdout and f"{len(done)} already in the store" in rerun.stdout
-    assert "on 2 worker(s)" in rerun.stdout
+    assert "2 worker(s) at the end" in rerun.stdout
     assert_store_matches(store, reference)
 
 
@@ -484,7 +488,7 @@ def test_a_sweep_whose_every_job_fails_exits_1_with_its_rows_stored(tmp_path):
     path.write_text('[sweep]\nname = "lonely"\nreplicates = 2\n[swarm]\nagents = 1\nduration = 1\n')
     proc = run_cli("sweep", path, "--store", tmp_path / "r.duckdb", "--workers", "1")
     assert proc.returncode == 1 and "Traceback" not in proc.stderr
-    line = (f"error: sweep 'lonely': all 2 jobs failed (the log has 0 event(s); at least 2 encounters are needed "
+    line = (f"error: sweep 'lonely': all 2 jobs failed (error: the log has 0 event(s); at least 2 encounters are needed "
             f"to build a map); their rows are in {tmp_path / 'r.duckdb'}")
     assert proc.stderr.strip().splitlines() == [line]
     assert [row["error"] is not None for row in read_jobs(tmp_path / "r.duckdb")] == [True, True]

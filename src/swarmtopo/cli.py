@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import re
+import shlex
 import sys
 from contextlib import contextmanager
 from pathlib import Path
@@ -497,7 +498,8 @@ def _demo_wrote(log_dir: Path) -> bool:
 
 
 @app.command(epilog="Example: swarmtopo sweep examples/sweep-small.toml --store results.duckdb --workers 2  "
-                    "(run it again after a crash or Ctrl-C: finished jobs are skipped)")
+                    "(run it again after a crash or Ctrl-C: finished jobs are skipped; "
+                    "swarmtopo status results.duckdb shows the progress from another terminal)")
 def sweep(
     config: Path = typer.Argument(..., help="Sweep grid: a TOML file with sweep, arena, swarm and map tables."),
     store: Path = typer.Option(..., "--store", help="DuckDB result store (created; one row per job in table jobs)."),
@@ -505,37 +507,52 @@ def sweep(
                                             help="Address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786."),
     workers: Optional[int] = typer.Option(None, "--workers", min=1,
                                           help="Worker processes of the local cluster (default: all cores)."),
+    job_timeout: Optional[float] = typer.Option(None, "--job-timeout", min=0.001,
+                                                help="Seconds a job may run before it is killed and stored as a "
+                                                     "timeout row (default: [sweep] job_timeout, else 3600)."),
+    retry_failed: bool = typer.Option(False, "--retry-failed",
+                                      help="Run again the jobs stored as failed (error, crashed, timeout)."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
     """Run every simulate-and-map job of a grid on Dask and store one row per job.
 
     Jobs already in the store are skipped, so a sweep can be resumed or grown.  A job
-    that cannot be mapped (too little data) is a stored row with its error; if every job
-    of the grid is, the sweep exits 1.
+    that raises, crashes its process or runs past the job timeout is a stored row with
+    its failure kind and message, and the sweep goes on; a rerun skips failed rows
+    unless --retry-failed.  If every job of the grid failed, the sweep exits 1.
     """
     from .experiments.grid import read_sweep
-    from .experiments.sweep import run_sweep
+    from .experiments.sweep import SchedulerLost, run_sweep
 
     _check_verbosity(quiet, verbose)
     grid = read_sweep(config)
+    timeout = grid.job_timeout if job_timeout is None else job_timeout
     if verbose:
         _detail(f"sweep {grid.name!r} from {config}: {len(grid.jobs)} jobs ({grid.replicates} replicate(s), "
-                f"salt {grid.salt!r})")
+                f"salt {grid.salt!r}), job timeout {timeout:g} s, rows keep diagrams: {grid.diagrams}")
     try:
         with _sweep_progress(quiet, verbose) as tick:
-            summary = run_sweep(grid.jobs, store, scheduler=scheduler, workers=workers, progress=tick)
+            summary = run_sweep(grid.jobs, store, scheduler=scheduler, workers=workers, progress=tick,
+                                job_timeout=timeout, retry_failed=retry_failed, keep=grid.diagrams)
     except KeyboardInterrupt:
         if not quiet:
             err.print(f"interrupted: finished jobs are saved in {store}; run the same command again to run the rest",
                       markup=False, highlight=False, soft_wrap=True)
         raise typer.Exit(130) from None
+    except SchedulerLost as exc:
+        command = ["swarmtopo", "sweep", str(config), "--store", str(store), "--scheduler", str(scheduler)]
+        command += (["--job-timeout", f"{job_timeout:g}"] if job_timeout is not None else [])
+        command += ["--retry-failed"] if retry_failed else []
+        err.print(f"error: {exc}; once the scheduler is back, resume with: {shlex.join(command)}",
+                  markup=False, highlight=False, soft_wrap=True)
+        raise typer.Exit(1) from None
     # every job failed (the grid, not the data, is likely wrong): only then read the rows run before
-    errors = _stored_errors(store, grid.jobs) if summary.failed == summary.run else {}
-    if summary.total and sum(errors.values()) == summary.total:
-        message = max(errors.items(), key=lambda item: item[1])[0]
-        err.print(f"error: sweep {grid.name!r}: all {summary.total} jobs failed ({message}); their rows are in "
-                  f"{store}", markup=False, highlight=False, soft_wrap=True)
+    failures = _stored_failures(store, grid.jobs) if summary.n_failed == summary.run else []
+    if summary.total and sum(g.count for g in failures) == summary.total:
+        first = failures[0]
+        err.print(f"error: sweep {grid.name!r}: all {summary.total} jobs failed ({first.status}: {first.example}); "
+                  f"their rows are in {store}", markup=False, highlight=False, soft_wrap=True)
         raise typer.Exit(1)
     if quiet:
         return
@@ -543,24 +560,64 @@ def sweep(
         out.print(f"sweep {grid.name!r}: all {summary.total} jobs already in {store}; nothing to run",
                   markup=False, highlight=False)
         return
-    out.print(f"sweep {grid.name!r}: {summary.total} jobs: {summary.run} run ({summary.failed} failed), "
-              f"{summary.skipped} already in the store", markup=False, highlight=False)
-    out.print(f"{summary.run} jobs in {summary.seconds:.1f} s on {summary.workers} worker(s): "
+    kinds = ", ".join(f"{n} {kind}" for kind, n in sorted(summary.failed.items()))
+    out.print(f"sweep {grid.name!r}: {summary.total} jobs: {summary.run} run ({summary.n_failed} failed"
+              f"{': ' + kinds if kinds else ''}), {summary.skipped} already in the store",
+              markup=False, highlight=False)
+    out.print(f"{summary.run} jobs in {summary.seconds:.1f} s, {summary.workers} worker(s) at the end: "
               f"{summary.jobs_per_minute:.1f} jobs/minute", markup=False, highlight=False)
-    for message, count in sorted(summary.errors.items(), key=lambda item: -item[1])[:3]:
-        out.print(f"failed {count}x: {message}", markup=False, highlight=False, soft_wrap=True)
+    for line in _failure_lines(summary.failures):
+        out.print(line, markup=False, highlight=False, soft_wrap=True)
     out.print(f"results: {store} (table jobs)", markup=False, highlight=False)
 
 
-def _stored_errors(store: Path, jobs) -> dict[str, int]:
-    """Error message -> number of ``jobs`` stored with it (those run now and those run before)."""
-    from collections import Counter
+def _failure_lines(groups, most: int = 3) -> list[str]:
+    """The largest failure groups, one line each (messages that differ only in numbers are one group)."""
+    lines = [f"failed {g.count}x ({g.status}): {g.example}" + (" (numbers vary)" if g.count > 1 else "")
+             for g in groups[:most]]
+    if len(groups) > most:
+        lines.append(f"... and {sum(g.count for g in groups[most:])} more failed rows of "
+                     f"{len(groups) - most} other kind(s)")
+    return lines
 
-    from .experiments.store import read_jobs
 
-    keys = {job.key for job in jobs}
-    return dict(Counter(row["error"] for row in read_jobs(store, columns=("key", "error"))
-                        if row["key"] in keys and row["error"] is not None))
+def _stored_failures(store: Path, jobs):
+    """The failed rows stored for ``jobs`` (run now or before), grouped."""
+    from .experiments.store import group_failures, iter_jobs
+
+    rows = iter_jobs(store, keys=[job.key for job in jobs], columns=("key", "status", "error"))
+    return group_failures((row["status"], row["error"], 1) for row in rows if row["status"] != "ok")
+
+
+@app.command(epilog="Example: swarmtopo status results.duckdb  (while the sweep runs, from another terminal)")
+def status(
+    store: Path = typer.Argument(..., help="A sweep's DuckDB result store."),
+) -> None:
+    """What a result store holds: per sweep, jobs done, failed (by kind) and pending; the
+    most common failures; and whether a sweep is writing to it now."""
+    from datetime import datetime, timezone
+
+    from .experiments.store import RUN_STALE, store_status
+
+    found = store_status(store)
+    for s in found.sweeps:
+        failed = {k: n for k, n in s.counts.items() if k != "ok"}
+        kinds = ", ".join(f"{n} {kind}" for kind, n in sorted(failed.items()))
+        out.print(f"sweep {s.sweep!r}: {s.asked} jobs: {s.counts.get('ok', 0)} done, {sum(failed.values())} failed"
+                  f"{' (' + kinds + ')' if kinds else ''}, {s.pending} pending", markup=False, highlight=False)
+    for line in _failure_lines(found.failures, most=5):
+        out.print(line, markup=False, highlight=False, soft_wrap=True)
+    now = datetime.now(timezone.utc).replace(tzinfo=None)
+    for run in found.runs[-3:]:
+        ago = (now - run["updated_at"]).total_seconds()
+        where = f"{run['host']}:{run['pid']} on {run['scheduler']}, {run['workers']} worker(s)"
+        if run["outcome"] is not None:
+            state = f"ended ({run['outcome']}) {ago:.0f} s ago"
+        elif ago < RUN_STALE:
+            state = f"running since {run['started_at']:%Y-%m-%d %H:%M:%S} UTC, last write {ago:.0f} s ago"
+        else:
+            state = f"stopped without ending (killed?) {ago:.0f} s ago"
+        out.print(f"run {where}: {state}", markup=False, highlight=False)
 
 
 @app.command(epilog="Example: swarmtopo reproduce encmds --out reproduction/encmds --runs 5  "

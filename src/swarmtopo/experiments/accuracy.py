@@ -37,7 +37,6 @@ from scipy.stats import bootstrap
 from ..arena import HOLE_SHAPES, OUTER_SHAPES
 from ..topology.cycles import wilson_interval
 from ..errors import SwarmtopoError
-from ..topology.persistence import Diagram
 from ..readers.paper import published_paper_classifier
 from ..readers.registry import load_classifier
 from ..pipeline import MapConfig
@@ -294,7 +293,7 @@ def outcomes(rows, classifier, cells=CELLS) -> list[dict[str, Any]]:
         config = row["config"]
         est0, est1, conf0, conf1 = row["est_betti0"], None, None, None
         if row["error"] is None:
-            regions = [[Diagram.from_json(w["diagram"]) for w in r["windows"]] for r in row["diagrams"]]
+            regions = [[w["diagram"] for w in r["windows"]] for r in row["diagrams"]]
             readings = [classifier.read(windows) for windows in regions]
             est1 = sum(reading.betti.get(1, 0) for reading in readings)
             conf1 = classifier.map_confidence([reading.confidence.get(1) for reading in readings], 1)
@@ -427,7 +426,8 @@ def run_benchmark(store, *, quick: bool = False, scheduler: str | None = None, w
     per_cell = per_cell or (QUICK_PER_CELL if quick else REPORTING_PER_CELL)
     jobs = reporting_jobs(per_cell, cells=cells)
     planning = planning_jobs(planning_per_cell, planning_cells) if planning_per_cell else []
-    summary = run_sweep(jobs + planning, store, scheduler=scheduler, workers=workers, progress=progress)
+    summary = run_sweep(jobs + planning, store, scheduler=scheduler, workers=workers, progress=progress,
+                        keep="windows")
     rows, planning_rows = job_rows_each(store, jobs, planning)
     by_pipeline = {name: [r for r in rows if _pipeline_of(r["config"]) == name] for name in PIPELINES}
     classifiers = {name: load_classifier(PIPELINES[name]["classifier"]) for name in PIPELINES}

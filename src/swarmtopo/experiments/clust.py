@@ -22,7 +22,6 @@ import numpy as np
 
 from .._validate import positive_int
 from ..readers.paper import detection_scores, published_paper_classifier
-from ..topology.persistence import Diagram
 from .grid import expand_grid
 from .store import read_jobs
 from .sweep import build_arena, run_sweep
@@ -92,7 +91,7 @@ def reproduce_clust(out: Path, *, runs: int | None = None, progress: Callable[[i
     job = next(j for j in sweeps["train"].jobs if j.key == example["key"])
     plot_arena(build_arena(job.config["arena"], job.stream_seeds()["arena"]), ax=axes[0],
                title="(a) a training environment")
-    dgm = Diagram.from_json(example["diagrams"][0]["diagram"])
+    dgm = example["diagrams"][0]["diagram"]
     plot_diagram(dgm, ax=axes[1], thresholds=winner.thresholds(dgm), title="(b) its diagram")
     plot_ratio_density(train.diagrams, train.truth, winner.theta_[1], ax=axes[2],
                        title="(c) scaled interval lengths, training set")

@@ -6,6 +6,8 @@ Format (``examples/sweep-small.toml`` is a commented example)::
     name = "two-holes"        # label of the sweep (default: the file name without .toml)
     replicates = 5            # jobs (seeds) per grid point (default 1)
     salt = "train"            # text mixed into every job's seed and key (default "")
+    job_timeout = 3600        # seconds a job may run before it is killed: a "timeout" row (default 3600)
+    diagrams = "map"          # diagrams each row keeps: none | map | windows (default "map")
 
     [arena]
     generator = "random"      # random | default | square | annulus | two_rooms | file
@@ -211,7 +213,15 @@ PARAMS: tuple[Param, ...] = (
 )
 """Every grid key, in expansion order (the last key varies fastest)."""
 GRID_TABLES = ("arena", "swarm", "map")
-SWEEP_KEYS = ("name", "replicates", "salt")
+SWEEP_KEYS = ("name", "replicates", "salt", "job_timeout", "diagrams")
+DEFAULT_JOB_TIMEOUT = 3600.0
+"""Seconds a job may run before it is killed and stored as a "timeout" row (``[sweep]
+job_timeout``): generous, the benchmark's largest maps take about a minute on one core."""
+KEEP_LEVELS = ("none", "map", "windows")
+"""What a row's ``diagrams`` keeps (``[sweep] diagrams``), least to most: each region's
+and window's metadata always; ``map`` adds each region's own diagram (its representative
+window's); ``windows`` every window's diagram (what re-reading the windows with another
+classifier needs)."""
 MAX_JOBS = 1_000_000
 """Most jobs a sweep may expand to (grid points x replicates): months of maps on one
 machine, and their Job objects still fit in memory."""
@@ -301,6 +311,8 @@ class Sweep:
     replicates: int
     jobs: tuple[Job, ...]
     source: str
+    job_timeout: float = DEFAULT_JOB_TIMEOUT
+    diagrams: str = "map"
 
 
 def canonical_json(obj) -> str:
@@ -372,6 +384,8 @@ def expand_grid(document: dict, *, source: str = "<grid>", base_dir=None,
     if not isinstance(salt, str):
         fail(f"[sweep] salt = {_toml(salt)}", "expected a string")
     replicates = _scalar(head, "replicates", 1, _integer(1), fail)
+    job_timeout = _scalar(head, "job_timeout", DEFAULT_JOB_TIMEOUT, _number(0.0, strict=True), fail)
+    diagrams = _scalar(head, "diagrams", "map", _choice(KEEP_LEVELS), fail)
 
     known = {(p.table, p.name) for p in PARAMS}
     for table in GRID_TABLES:
@@ -403,7 +417,8 @@ def expand_grid(document: dict, *, source: str = "<grid>", base_dir=None,
 
     jobs = tuple(Job(sweep=name, config_json=config, replicate=r, salt=salt, files=files)
                  for config, files in configs.items() for r in range(replicates))
-    return Sweep(name=name, salt=salt, replicates=replicates, jobs=jobs, source=source)
+    return Sweep(name=name, salt=salt, replicates=replicates, jobs=jobs, source=source, job_timeout=job_timeout,
+                 diagrams=diagrams)
 
 
 def flat_columns(config: dict) -> dict[str, Any]:

@@ -5,14 +5,18 @@ encounter log, all seeded from the job alone (:meth:`~.grid.Job.stream_seeds`), 
 row depends on nothing but its job: not on the worker, the number of workers, the
 order of completion or the other jobs.  ``run_sweep(jobs, store)`` skips jobs whose
 key is in the store, submits the rest to a Dask cluster (a local one by default, or
-an existing scheduler) and writes each row from the client as soon as its job
-finishes, one transaction per row: killing the sweep at any moment loses at most the
-jobs still running, and running it again finishes exactly those.
+an existing scheduler) a window at a time, and writes the rows from the client in
+batches (one transaction each, at least every ``FLUSH_SECONDS``): killing the sweep at
+any moment loses at most the jobs running and the last second's rows, and running it
+again finishes exactly those.
 
-A job that fails with a :class:`~swarmtopo.errors.SwarmtopoError` (too little data to
-map, holes that do not fit) is a result: its row has the message in ``error`` and
-NULL estimates, and it is not run again.  Any other exception is a bug: the sweep
-stops and re-raises it (rows already written stay).
+A bad job is a row, not an abort.  Each worker runs its jobs in a child process
+(:func:`run_isolated`, :mod:`.isolation`): a job that raises is stored with status
+"error" (a SwarmtopoError such as too little data is the method's own answer; anything
+else is a bug, named by its type), one whose process dies "crashed", one that runs past
+the job timeout "timeout"; the sweep goes on, and a rerun skips failed rows unless
+asked to retry them.  A lost scheduler stops the sweep with :class:`SchedulerLost`
+after the finished rows are written.
 """
 
 from __future__ import annotations
@@ -21,12 +25,14 @@ import logging
 import os
 import socket
 import tempfile
+import threading
 import time
 from collections import Counter
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass, field, replace
 from datetime import datetime, timezone
 from functools import lru_cache
+from itertools import islice
 from typing import Any, Callable, Iterable
 
 from ..arena import Arena, annulus_arena, default_arena, random_arena, square_arena, two_rooms_arena
@@ -36,13 +42,14 @@ from ..errors import SwarmtopoError
 from ..io import GROUND_TRUTH_META_KEYS, read_arena, read_log, write_log
 from ..log import EncounterLog
 from ..topology.persistence import snr
-from ..pipeline import map_encounters
+from ..pipeline import MapConfig, map_encounters
 from ..pipeline.engine import POLL_SECONDS, connected_client, deferred_interrupt
 from ..pipeline.result import software_versions
 from ..viz.summary import window_json
 from ..sim import simulate
-from .grid import Job, flat_columns, job_map_config, job_simulation_args
-from .store import JOB_COLUMNS, ResultStore
+from .grid import DEFAULT_JOB_TIMEOUT, KEEP_LEVELS, Job, flat_columns, job_map_config, job_simulation_args
+from .isolation import JobProcess, one_line
+from .store import JOB_COLUMNS, LOCK_WAIT, FailureGroup, ResultStore, encode_regions, group_failures
 
 _STAGE_COLUMNS = {"graph": "t_graph", "landmarks": "t_landmarks", "persistence": "t_persistence",
                   "classify": "t_classify"}
@@ -127,7 +134,7 @@ def job_classifier(mapping: dict[str, Any]) -> str:
     return "trace" if name == "default" and map_input(mapping) == "contact-trace" else name
 
 
-def run_job(job: Job) -> dict[str, Any]:
+def run_job(job: Job, keep: str = "map") -> dict[str, Any]:
     """Simulate and map one job; its row of the store's ``jobs`` table.
 
     Streams (:meth:`Job.stream_seeds`): the arena's holes, the simulation, and the
@@ -136,20 +143,16 @@ def run_job(job: Job) -> dict[str, Any]:
     log read, as ``map``'s: ``trace`` for a contact trace), reading the stripped log folder or,
     with ``config["map"]["input"] = "contact-trace"`` (``INPUTS``; set by benchmark code,
     not a grid key), only its encounters; ``snr_h1`` is the paper's SNR
-    of the union diagram in dimension 1 given the true beta_1.
+    of the union diagram in dimension 1 given the true beta_1.  ``keep`` (``KEEP_LEVELS``)
+    says which persistence diagrams the row's ``diagrams`` holds.
 
-    Raises
-    ------
-    Exception
-        Anything but a SwarmtopoError (those become the row's ``error``).
+    A SwarmtopoError (too little data, holes that do not fit) is the row's ``error``
+    (status "error"); any other exception propagates (:func:`run_isolated` stores it).
     """
     start = time.perf_counter()
     config = job.config
     seeds = job.stream_seeds()
-    row: dict[str, Any] = dict.fromkeys(name for name, _ in JOB_COLUMNS)
-    row.update(key=job.key, sweep=job.sweep, replicate=job.replicate, salt=job.salt, seed=job.seed,
-               config=config, **flat_columns(config))
-    row["versions"] = dict(_versions())
+    row = _identity_row(job)
     swarm, mapping = config["swarm"], config["map"]
     try:
         arena = build_arena(config["arena"], seeds["arena"], job.file("arena.path"))
@@ -163,28 +166,90 @@ def run_job(job: Job) -> dict[str, Any]:
                               job_map_config(mapping, seeds["map"]),
                               reader=cached_classifier(job_classifier(mapping), job.file("map.classifier")))
     except SwarmtopoError as exc:
-        row["error"] = " ".join(str(exc).split())
+        row.update(status="error", error=" ".join(str(exc).split()))
     else:
         ratio = snr(tmap.diagram, 1, row["true_betti1"])
+        regions = [{"events": r.n_events, "agents": r.n_agents, "landmarks": len(r.landmarks.nodes),
+                    "window": r.window,
+                    "windows": [{**window_json(w), **({"diagram": w.diagram} if keep == "windows" else {})}
+                                for w in r.windows],
+                    **({"diagram": r.diagram} if keep != "none" else {})}
+                   for r in tmap.regions]
         row.update(
+            status="ok",
             est_betti0=tmap.betti[0], est_betti1=tmap.betti.get(1),
             confidence_betti0=tmap.confidence.get(0), confidence_betti1=tmap.confidence.get(1),
             snr_h1=ratio.ratio, noise_power_h1=ratio.noise_power,
             lengths_h1=[float(x) for x in tmap.diagram.lengths(1)],
-            diagrams=[{"events": r.n_events, "agents": r.n_agents, "landmarks": len(r.landmarks.nodes),
-                       "diagram": r.diagram.to_json(), "window": r.window,
-                       "windows": [{**window_json(w), "diagram": w.diagram.to_json()} for w in r.windows]}
-                      for r in tmap.regions],
-            n_regions=len(tmap.regions),
+            diagrams=encode_regions(regions), diagrams_kept=keep,
+            n_regions=len(tmap.regions), n_landmarks=sum(region["landmarks"] for region in regions),
             **{column: tmap.timings[stage] for stage, column in _STAGE_COLUMNS.items()},
         )
-        row["n_landmarks"] = sum(region["landmarks"] for region in row["diagrams"])
         row["versions"] = {**row["versions"], "classifier": tmap.classifier["classifier"],
                            "theta": tmap.classifier["theta"]}
-    row["worker"] = f"{socket.gethostname()}:{os.getpid()}"
     row["finished_at"] = datetime.now(timezone.utc).replace(tzinfo=None)
     row["t_total"] = time.perf_counter() - start
     return row
+
+
+def failed_row(job: Job, status: str, message: str, seconds: float | None = None) -> dict[str, Any]:
+    """The row of a job that did not finish: ``status`` a failure kind (``FAILURES``),
+    the one-line ``message``, the truth and estimates NULL."""
+    row = _identity_row(job)
+    row.update(status=status, error=message, t_total=seconds)
+    return row
+
+
+def _identity_row(job: Job) -> dict[str, Any]:
+    """A row with the job's identity and grid columns, this process as its worker, the rest NULL."""
+    row: dict[str, Any] = dict.fromkeys(name for name, _ in JOB_COLUMNS)
+    row.update(key=job.key, sweep=job.sweep, replicate=job.replicate, salt=job.salt, seed=job.seed,
+               config=job.config, **flat_columns(job.config), versions=dict(_versions()),
+               worker=f"{socket.gethostname()}:{os.getpid()}",
+               finished_at=datetime.now(timezone.utc).replace(tzinfo=None))
+    return row
+
+
+_PROCESSES = threading.local()
+
+
+def run_isolated(job: Job, keep: str, timeout: float | None, runner: Callable[[Job, str], dict] = run_job
+                 ) -> dict[str, Any]:
+    """The Dask task of a job: ``runner(job, keep)`` in this worker thread's child process
+    (:class:`~.isolation.JobProcess`), its row; a failed row if the call raised
+    ("error"), its process died ("crashed") or it ran past ``timeout`` s ("timeout")."""
+    process = getattr(_PROCESSES, "process", None)
+    if process is None:
+        process = _PROCESSES.process = JobProcess(warm_up)
+    start = time.perf_counter()
+    kind, value = process.call(_call_runner, (runner, job, keep), timeout)
+    if kind == "ok":
+        return value
+    return failed_row(job, kind, value, time.perf_counter() - start)
+
+
+def _call_runner(args):
+    runner, job, keep = args
+    return runner(job, keep)
+
+
+def warm_up() -> None:
+    """Load (or compile, on a cold numba cache) the kernels a job uses: map a small
+    simulated log once, before any job's timeout runs."""
+    log = simulate(square_arena(), 60, 8.0, rng=0).log
+    try:
+        map_encounters(log, MapConfig(seed=0, embed_dim=0, cycles=False))
+    except SwarmtopoError:
+        pass
+
+
+class SchedulerLost(SwarmtopoError):
+    """The connection to the Dask scheduler was lost mid-sweep (finished rows are saved)."""
+
+    def __init__(self, address: str, saved: int, remaining: int, reason: str):
+        self.address, self.saved, self.remaining = address, saved, remaining
+        super().__init__(f"lost the Dask scheduler at {address} ({reason}); {saved} row(s) saved this run, "
+                         f"{remaining} job(s) not run")
 
 
 @dataclass(frozen=True)
@@ -200,27 +265,37 @@ class SweepSummary:
     run
         Jobs run and written now.
     failed
-        Of those, rows with an ``error`` (too little data, ...).
+        Of those, rows of each failure kind (``FAILURES``) -> count.
     seconds
         Wall time of running them (cluster start included).
     workers
-        Dask workers at the start (0 when nothing had to run).
-    errors
-        Error message -> number of jobs run now that failed with it.
+        Dask workers at the end of the run (0 when nothing had to run).
+    failures
+        Failed rows of this run grouped by kind and message (:func:`~.store.group_failures`).
     """
 
     total: int
     skipped: int
     run: int
-    failed: int
+    failed: dict[str, int]
     seconds: float
     workers: int
-    errors: dict[str, int] = field(default_factory=dict)
+    failures: list[FailureGroup] = field(default_factory=list)
+
+    @property
+    def n_failed(self) -> int:
+        return sum(self.failed.values())
 
     @property
     def jobs_per_minute(self) -> float:
         """Jobs run per minute of wall time."""
         return 60.0 * self.run / self.seconds if self.seconds > 0 else 0.0
+
+
+FLUSH_SECONDS = 1.0
+"""Most seconds a finished row waits in the client before it is written."""
+FLUSH_ROWS = 500
+"""Rows per write at most (a batch is one transaction)."""
 
 
 def run_sweep(
@@ -230,15 +305,20 @@ def run_sweep(
     scheduler: str | None = None,
     workers: int | None = None,
     progress: Callable[[int, int, int], None] | None = None,
+    job_timeout: float | None = DEFAULT_JOB_TIMEOUT,
+    retry_failed: bool = False,
+    keep: str = "map",
+    runner: Callable[[Job, str], dict] = run_job,
 ) -> SweepSummary:
-    """Run the jobs not yet in the store on Dask; write one row per job as it finishes.
+    """Run the jobs not yet in the store on Dask; write their rows in batches as they finish.
 
     Parameters
     ----------
     jobs
         The jobs (duplicates by key run once); each is recorded as part of its sweep.
     store_path
-        The DuckDB result store (created if missing).
+        The DuckDB result store (created if missing; not created if the scheduler
+        cannot be reached).
     scheduler
         Address of an existing Dask scheduler (``tcp://host:port``).  None: start a
         local cluster of processes with one thread each.
@@ -246,88 +326,220 @@ def run_sweep(
         Processes of the local cluster (default: this machine's cores, at most one
         per job to run).  Not allowed with ``scheduler``.
     progress
-        Called as ``progress(done, total, failed)`` once the cluster is up and after
-        each row is written (``total`` = jobs to run now).
+        Called as ``progress(done, total, failed)`` before the cluster starts and
+        after each finished job (``total`` = jobs to run now).
+    job_timeout
+        Seconds a job may run (None: no limit); past it, it is killed and stored as a
+        "timeout" row.
+    retry_failed
+        Run again the jobs whose stored row failed (each new row replaces the old);
+        otherwise a failed row counts as done.
+    keep
+        Which diagrams each row keeps (``KEEP_LEVELS``); a stored row that keeps less
+        is run again.
+    runner
+        ``runner(job, keep) -> row``: :func:`run_job`, or a test's stand-in (importable
+        by the workers).
 
     Raises
     ------
+    SchedulerLost
+        The scheduler went away mid-sweep (finished rows are written first).
     SwarmtopoError
         On a store that cannot be opened, an unreachable scheduler or one without
-        workers.  KeyboardInterrupt and a job's non-user exception propagate after
-        the running tasks are cancelled and the cluster is shut down.
+        workers.  KeyboardInterrupt propagates after the finished rows are written,
+        the running tasks cancelled and the cluster shut down.
     """
     if scheduler is not None and workers is not None:
         raise SwarmtopoError(f"--workers sets the size of the local cluster; the scheduler at {scheduler} "
                              "has its own workers (drop --workers)")
+    if keep not in KEEP_LEVELS:
+        raise SwarmtopoError(f"diagrams to keep must be one of {', '.join(KEEP_LEVELS)}, got {keep!r}")
+    if job_timeout is not None and not job_timeout > 0:
+        raise SwarmtopoError(f"the job timeout must be a number of seconds > 0, got {job_timeout!r}")
     unique: dict[str, Job] = {}
     members: dict[str, list[str]] = {}  # sweep -> keys: a job shared by sweeps belongs to each
     for job in jobs:
         unique.setdefault(job.key, job)
         members.setdefault(job.sweep, []).append(job.key)
-    with ResultStore(store_path) as store:
+    say = progress or (lambda done, total, failed: None)
+    with ExitStack() as stack:
+        # an existing scheduler first: one that cannot be reached must not leave a store behind
+        client = stack.enter_context(connected_client(scheduler)) if scheduler is not None else None
+        store = ResultStore(store_path)
         for sweep, keys in members.items():
             store.add_to_sweep(sweep, keys)
-        done = store.finished_keys()
-        pending = [job for key, job in unique.items() if key not in done]
+        stored = store.stored()
+        pending = [job for key, job in unique.items() if not _finished(stored.get(key), keep, retry_failed)]
         if not pending:
-            return SweepSummary(total=len(unique), skipped=len(unique), run=0, failed=0, seconds=0.0, workers=0)
+            return SweepSummary(total=len(unique), skipped=len(unique), run=0, failed={}, seconds=0.0, workers=0)
         start = time.perf_counter()
-        errors: Counter[str] = Counter()
-        run = 0
-        with _dask_client(scheduler, workers, len(pending)) as (client, n_workers):
-            from distributed import as_completed
+        say(0, len(pending), 0)
+        if client is None:
+            client = stack.enter_context(_local_client(workers, len(pending)))
+        batch = _Batches(store, scheduler, client)
+        try:
+            _run_pending(client, pending, batch, say, keep=keep, timeout=job_timeout, runner=runner,
+                         address=scheduler or "the local cluster")
+        finally:
+            batch.close()
+        return SweepSummary(total=len(unique), skipped=len(unique) - len(pending), run=batch.written,
+                            failed=dict(batch.failed), seconds=time.perf_counter() - start,
+                            workers=batch.workers, failures=group_failures(
+                                (status, message, 1) for status, message in batch.messages))
 
-            say = progress or (lambda done, total, failed: None)
-            futures = dict(zip((job.key for job in pending),
-                               client.map(run_job, pending, key=[f"swarmtopo-job-{job.key}" for job in pending])))
-            say(0, len(pending), 0)
-            finished = as_completed(list(futures.values()))
-            try:
-                with deferred_interrupt() as interrupted:
-                    while not finished.is_empty():
-                        if interrupted():
-                            raise KeyboardInterrupt
-                        batch = finished.next_batch(block=False)
-                        if not batch:
-                            time.sleep(POLL_SECONDS)
-                        for future in batch:
-                            row = future.result()
-                            store.insert(row)
-                            futures.pop(row["key"]).release()
-                            run += 1
-                            if row["error"] is not None:
-                                errors[row["error"]] += 1
-                            say(run, len(pending), sum(errors.values()))
-            finally:
-                client.cancel(list(futures.values()))
-        return SweepSummary(total=len(unique), skipped=len(unique) - len(pending), run=run,
-                            failed=sum(errors.values()), seconds=time.perf_counter() - start,
-                            workers=n_workers, errors=dict(errors))
+
+def _finished(stored: tuple[str, str | None] | None, keep: str, retry_failed: bool) -> bool:
+    """Whether a job with this stored (status, diagrams_kept) is done."""
+    if stored is None:
+        return False
+    status, kept = stored
+    if status != "ok":
+        return not retry_failed
+    return KEEP_LEVELS.index(kept) >= KEEP_LEVELS.index(keep)
+
+
+class _Batches:
+    """Finished rows on their way to the store: written every ``FLUSH_SECONDS`` or
+    ``FLUSH_ROWS``, kept in memory (and retried) while another process holds the file."""
+
+    def __init__(self, store: ResultStore, scheduler: str | None, client):
+        self.store, self.client = store, client
+        self.workers = _worker_count(client)
+        self.run = store.start_run(scheduler, self.workers)
+        self.rows: list[dict[str, Any]] = []
+        self.written = 0
+        self.failed: Counter[str] = Counter()
+        self.messages: list[tuple[str, str]] = []
+        self.last = time.monotonic()
+        self.outcome = "interrupted"
+
+    def add(self, row: dict[str, Any]) -> None:
+        self.rows.append(row)
+        if row["status"] != "ok":
+            self.failed[row["status"]] += 1
+            self.messages.append((row["status"], row["error"]))
+        if len(self.rows) >= FLUSH_ROWS or time.monotonic() - self.last >= FLUSH_SECONDS:
+            self.flush()
+
+    @property
+    def done(self) -> int:
+        return self.written + len(self.rows)
+
+    def flush(self, wait: float = 0.0) -> None:
+        self.last = time.monotonic()
+        while self.rows:
+            chunk = self.rows[:FLUSH_ROWS]
+            if not self.store.write(chunk, wait=wait):
+                return  # the file is busy: the rows wait for the next flush
+            del self.rows[:FLUSH_ROWS]
+            self.written += len(chunk)
+        self.workers = _worker_count(self.client, self.workers)
+        self.store.touch_run(self.run, self.workers)
+
+    def close(self) -> None:
+        """Write what is left (waiting up to LOCK_WAIT for the file), and how the run ended."""
+        self.flush(wait=LOCK_WAIT)
+        if self.rows:
+            raise SwarmtopoError(f"{self.store.path}: {len(self.rows)} finished row(s) could not be written: "
+                                 f"another process has held the store for {LOCK_WAIT:g} s")
+        self.store.touch_run(self.run, self.workers, self.outcome, wait=LOCK_WAIT)
+
+
+def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, timeout, runner, address) -> None:
+    """Submit the jobs in a bounded window, collect each row as it finishes (a failed row
+    for a job whose workers died), until all are written or something stops the sweep."""
+    from concurrent.futures import CancelledError
+
+    from distributed import as_completed
+    from distributed.scheduler import KilledWorker
+
+    queue = iter(pending)
+    window = max(IN_FLIGHT, 4 * sum(client.nthreads().values()))
+    running: dict[str, tuple[Any, Job]] = {}  # task key -> (future, job)
+    finished = as_completed()
+
+    def submit(n: int) -> None:
+        chunk = list(islice(queue, n))
+        if chunk:
+            futures = client.map(run_isolated, chunk, key=[f"swarmtopo-job-{job.key}" for job in chunk],
+                                 keep=keep, timeout=timeout, runner=runner)
+            running.update((future.key, (future, job)) for future, job in zip(futures, chunk))
+            finished.update(futures)
+
+    submit(window)
+    try:
+        with deferred_interrupt() as interrupted:
+            while running:
+                if interrupted():
+                    raise KeyboardInterrupt
+                done = finished.next_batch(block=False)
+                if not done:
+                    if client.status != "running":
+                        raise SchedulerLost(address, batch.done, len(running) + _left(queue), "connection closed")
+                    time.sleep(POLL_SECONDS)
+                    if time.monotonic() - batch.last >= FLUSH_SECONDS:
+                        batch.flush()
+                for future in done:
+                    _, job = running.pop(future.key)
+                    try:
+                        row = future.result()
+                    except KilledWorker as exc:
+                        row = failed_row(job, "crashed", f"its workers died running it ({one_line(exc)})")
+                    except CancelledError:
+                        raise SchedulerLost(address, batch.done, len(running) + 1 + _left(queue),
+                                            "its tasks were cancelled: scheduler-connection-lost") from None
+                    except Exception as exc:  # noqa: BLE001 - a job's own failure is its row
+                        row = failed_row(job, "error", one_line(exc))
+                    future.release()
+                    batch.add(row)
+                    say(batch.done, len(pending), sum(batch.failed.values()))
+                if len(running) < window // 2:
+                    submit(window - len(running))
+        batch.outcome = "finished"
+    except SchedulerLost:
+        batch.outcome = "scheduler lost"
+        raise
+    finally:
+        if running and client.status == "running":
+            client.cancel([future for future, _ in running.values()])
+
+
+IN_FLIGHT = 256
+"""Jobs submitted ahead at least (four per worker thread if more): the scheduler holds a
+window of the sweep, not all of it, so a 10^5-job sweep costs the client little memory."""
+
+
+def _left(queue) -> int:
+    return sum(1 for _ in queue)
+
+
+def _worker_count(client, default: int = 0) -> int:
+    """Workers the scheduler has now (``default`` if it cannot say)."""
+    try:
+        return len(client.scheduler_info(n_workers=-1)["workers"]) if client.status == "running" else default
+    except Exception:  # noqa: BLE001 - a count for the summary, never a reason to fail
+        return default
 
 
 @contextmanager
-def _dask_client(scheduler: str | None, workers: int | None, n_jobs: int):
-    """(Client, number of workers) on the given scheduler or a new local cluster; closes both."""
+def _local_client(workers: int | None, n_jobs: int):
+    """A Client of a new local cluster (one-thread worker processes); closes both."""
     from distributed import Client, LocalCluster
 
-    if scheduler is not None:
-        with connected_client(scheduler) as client:  # workers started by hand: one numba thread each too
-            yield client, len(client.nthreads())
-        return
     n_workers = min(workers or os.cpu_count() or 1, n_jobs)
     # One core per worker: numba's parallel kernels would otherwise start one thread per
     # core in every worker (BLAS / OpenMP threads are already 1 under Dask's nanny).  The
     # scheduler's HTTP server takes any free port (8787 may be another cluster's).  The
-    # workers preload this module (its imports take seconds) and swarmtopo._dask_plugin
-    # (its dask_setup: they ignore SIGINT, which the client alone handles).
-    # Only CRITICAL logs: a job's own exception reaches the client through its future,
-    # and after Ctrl-C a worker may log an ERROR with a traceback ("failed to communicate
-    # with scheduler during heartbeat") while the cluster it belongs to shuts down.
+    # workers preload swarmtopo._dask_plugin (its dask_setup: they ignore SIGINT, which
+    # the client alone handles).  Only CRITICAL logs: a job's own exception reaches the
+    # client through its future, and after Ctrl-C a worker may log an ERROR with a
+    # traceback while the cluster it belongs to shuts down.
     with LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=":0",
                       silence_logs=logging.CRITICAL, env={"NUMBA_NUM_THREADS": "1"},
-                      preload=["swarmtopo._dask_plugin", __name__]) as cluster:
+                      preload=["swarmtopo._dask_plugin"]) as cluster:
         with Client(cluster) as client:
-            yield client, n_workers
+            yield client
 
 
 @lru_cache(maxsize=8)

@@ -73,7 +73,7 @@ def examples_from_rows(rows: Sequence[dict[str, Any]]) -> Examples:
         if row["true_betti0"] != 1:
             excluded["disconnected arena"] += 1
             continue
-        diagrams.append(Diagram.from_json(row["diagrams"][0]["diagram"]))
+        diagrams.append(row["diagrams"][0]["diagram"])
         truth.append(row["true_betti1"])
     return Examples(diagrams, np.array(truth, dtype=np.int64), np.array(beta0, dtype=bool), excluded)
 
