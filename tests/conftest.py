@@ -238,25 +238,52 @@ def stop_group(proc: subprocess.Popen) -> None:
             continue
 
 
-@pytest.fixture(scope="module")
-def dask_cluster(tmp_path_factory):
-    """A real `dask scheduler` and a `dask worker` with 2 processes on 127.0.0.1."""
+TESTS = Path(__file__).resolve().parent
+
+
+def result_columns(row):
+    """A store row's result columns (run columns aside) as plain JSON data: its diagrams
+    decoded, Diagram objects as JSON; equal for a row from ``run_job`` and its stored copy."""
+    from swarmtopo.experiments.store import RUN_COLUMNS, decode_regions
+    from swarmtopo.topology.persistence import Diagram
+
+    out = {k: v for k, v in row.items() if k not in RUN_COLUMNS}
+    if isinstance(out.get("diagrams"), bytes):
+        out["diagrams"] = decode_regions(out["diagrams"])
+    return json.loads(json.dumps(out, default=lambda x: x.to_json() if isinstance(x, Diagram) else str(x)))
+
+
+@contextlib.contextmanager
+def local_dask(logs: Path, workers: int = 2, nanny: bool = True):
+    """A real `dask scheduler` and ``workers`` `dask worker` processes of one thread on
+    127.0.0.1: yields (address, scheduler process, worker processes).  The workers can import this folder's modules
+    (tests/sweep_faults.py: jobs that crash, raise or hang), and so can the scheduler, which
+    unpickles the tasks it is sent."""
     from distributed import Client
 
     address = f"tcp://127.0.0.1:{free_port()}"
-    logs = tmp_path_factory.mktemp("dask")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(TESTS), os.environ.get("PYTHONPATH")]))}
     procs = []
     try:
         procs.append(subprocess.Popen(
             ["dask", "scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1], "--no-dashboard"],
-            stdout=subprocess.DEVNULL, stderr=open(logs / "scheduler.log", "w"), start_new_session=True))
-        procs.append(subprocess.Popen(
-            ["dask", "worker", address, "--nworkers", "2", "--nthreads", "1", "--host", "127.0.0.1",
-             "--no-dashboard", "--local-directory", str(logs)],
-            stdout=subprocess.DEVNULL, stderr=open(logs / "worker.log", "w"), start_new_session=True))
+            stdout=subprocess.DEVNULL, stderr=open(logs / "scheduler.log", "w"), start_new_session=True, env=env))
+        for i in range(workers):
+            procs.append(subprocess.Popen(
+                ["dask", "worker", address, "--nthreads", "1", "--host", "127.0.0.1", "--no-dashboard",
+                 "--local-directory", str(logs), *([] if nanny else ["--no-nanny"])],
+                stdout=subprocess.DEVNULL, stderr=open(logs / f"worker{i}.log", "w"), start_new_session=True,
+                env=env))
         with Client(address, timeout=60) as client:
-            client.wait_for_workers(2, timeout=120)
-        yield address
+            client.wait_for_workers(workers, timeout=120)
+        yield address, procs[0], procs[1:]
     finally:
         for proc in reversed(procs):
             stop_group(proc)
+
+
+@pytest.fixture(scope="module")
+def dask_cluster(tmp_path_factory):
+    """A real `dask scheduler` and a `dask worker` with 2 processes on 127.0.0.1 (:func:`local_dask`)."""
+    with local_dask(tmp_path_factory.mktemp("dask")) as (address, _, _):
+        yield address

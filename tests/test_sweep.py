@@ -22,8 +22,7 @@ import pytest
 
 from swarmtopo.errors import InputError, SwarmtopoError
 from swarmtopo.experiments.grid import PARAMS, STORE_INT_MAX, expand_grid, read_sweep
-from swarmtopo.experiments.store import RUN_COLUMNS, ResultStore, decode_regions, read_jobs
-from swarmtopo.topology.persistence import Diagram
+from swarmtopo.experiments.store import ResultStore, decode_regions, read_jobs
 from swarmtopo.experiments.sweep import job_map_config, run_job, run_sweep
 from swarmtopo.pipeline import MapConfig
 
@@ -45,15 +44,7 @@ landmarks = 100
 """
 
 
-from conftest import stop_group, run_cli  # noqa: E402  (the CLI in-process)
-
-
-def result_columns(row):
-    """The row's result columns as plain JSON data (diagrams decoded, Diagram objects as JSON)."""
-    out = {k: v for k, v in row.items() if k not in RUN_COLUMNS}
-    if isinstance(out.get("diagrams"), bytes):
-        out["diagrams"] = decode_regions(out["diagrams"])
-    return json.loads(json.dumps(out, default=lambda x: x.to_json() if isinstance(x, Diagram) else str(x)))
+from conftest import result_columns, stop_group, run_cli  # noqa: E402  (the CLI in-process)
 
 
 @pytest.fixture(scope="module")

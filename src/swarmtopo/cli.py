@@ -573,7 +573,7 @@ def sweep(
 
 def _failure_lines(groups, most: int = 3) -> list[str]:
     """The largest failure groups, one line each (messages that differ only in numbers are one group)."""
-    lines = [f"failed {g.count}x ({g.status}): {g.example}" + (" (numbers vary)" if g.count > 1 else "")
+    lines = [f"failed {g.count}x ({g.status}): {g.example}" + (" (numbers vary)" if g.varied else "")
              for g in groups[:most]]
     if len(groups) > most:
         lines.append(f"... and {sum(g.count for g in groups[most:])} more failed rows of "

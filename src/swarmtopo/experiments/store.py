@@ -155,7 +155,10 @@ def decode_regions(blob: bytes) -> list[dict[str, Any]]:
 
 # -- opening the file ---------------------------------------------------------------------
 def _is_lock_conflict(exc: Exception) -> bool:
-    return "lock" in str(exc).lower()
+    """Whether DuckDB refused the file because it is open elsewhere: by another process
+    (a lock) or, in this process, by a connection of the other mode."""
+    text = str(exc).lower()
+    return "lock" in text or "different configuration" in text
 
 
 def _connect(path: Path, *, read_only: bool, wait: float):
@@ -393,17 +396,20 @@ class FailureGroup:
     status: str
     count: int
     example: str
+    varied: bool = False
+    """Whether the group's messages differ (in their numbers)."""
 
 
 def group_failures(failures: Iterable[tuple[str, str, int]]) -> list[FailureGroup]:
     """(status, message, count) triples grouped by status and :func:`message_pattern`,
     largest first; each group's example is its first message in sorted order."""
-    groups: dict[tuple[str, str], list] = {}
+    groups: dict[tuple[str, str], tuple[int, set[str]]] = {}
     for status, message, count in failures:
-        entry = groups.setdefault((status, message_pattern(message or "")), [0, message or ""])
-        entry[0] += count
-        entry[1] = min(entry[1], message or "")
-    return sorted((FailureGroup(status, count, example) for (status, _), (count, example) in groups.items()),
+        n, messages = groups.setdefault((status, message_pattern(message or "")), (0, set()))
+        messages.add(message or "")
+        groups[status, message_pattern(message or "")] = (n + count, messages)
+    return sorted((FailureGroup(status, n, min(messages), len(messages) > 1)
+                   for (status, _), (n, messages) in groups.items()),
                   key=lambda g: (-g.count, g.status, g.example))
 
 

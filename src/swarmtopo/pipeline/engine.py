@@ -113,6 +113,11 @@ def connected_client(address: str):
         client = Client(address, timeout=CONNECT_TIMEOUT)
     except (OSError, ValueError, TypeError) as exc:
         raise SwarmtopoError(f"cannot connect to the Dask scheduler at {address!r} ({exc})") from None
+    # a lost scheduler is the caller's one-line error: not the client's reconnection tracebacks
+    quiet = [logging.getLogger(name) for name in ("distributed.client", "distributed.utils")]
+    levels = [logger.level for logger in quiet]
+    for logger in quiet:
+        logger.setLevel(logging.CRITICAL)
     try:
         try:
             client.wait_for_workers(1, timeout=WORKER_WAIT)
@@ -123,6 +128,8 @@ def connected_client(address: str):
         yield client
     finally:
         client.close()
+        for logger, level in zip(quiet, levels):
+            logger.setLevel(level)
 
 
 @contextmanager
