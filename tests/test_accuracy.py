@@ -14,6 +14,7 @@ from swarmtopo.readers.registry import load_classifier
 from swarmtopo.errors import SwarmtopoError
 from swarmtopo.experiments import accuracy as acc
 from swarmtopo.experiments.grid import canonical_json
+from swarmtopo.experiments.store import decode_regions
 from swarmtopo.experiments.sweep import run_job
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -159,7 +160,7 @@ def test_outcomes_read_a_two_region_map_by_the_classifiers_power_of_the_product(
                       "swarm": {"agents": 300, "duration": 40.0}},
            "est_betti0": 2, "true_betti0": 2, "true_betti1": 1, "error": None, "confidence_betti0": 0.99,
            "replicate": 0, "t_total": 1.0,
-           "diagrams": [{"windows": [{"diagram": d.to_json()} for d in windows]} for windows in regions]}
+           "diagrams": [{"windows": [{"diagram": d} for d in windows]} for windows in regions]}
     classifier = load_classifier("default")
     [record] = acc.outcomes([row], classifier)
     confidences = [classifier.region_confidence(windows, vote(classifier, windows))[1] for windows in regions]
@@ -246,10 +247,11 @@ def test_contact_trace_keeps_only_the_encounters_and_maps_from_them():
     row, default_row = run_job(job), run_job(default_job)
     assert row["n_events"] == default_row["n_events"] and row["error"] is None  # the same case, simulated alike
     assert row["diagrams"] != default_row["diagrams"]  # mapped with other weights (h from the data, no wall following)
+    regions, default_regions = decode_regions(row["diagrams"]), decode_regions(default_row["diagrams"])
     # classifier "default" is map's: the trace classifier for a trace, and the bands each was fitted with
     assert (row["versions"]["classifier"], default_row["versions"]["classifier"]) == ("trace", "default")
-    assert {w["band"] for r in row["diagrams"] for w in r["windows"]} == set(load_classifier("trace").landmark_bands)
-    assert {w["band"] for r in default_row["diagrams"] for w in r["windows"]} == set(acc.PIPELINES["default"]["landmark_bands"])
+    assert {w["band"] for r in regions for w in r["windows"]} == set(load_classifier("trace").landmark_bands)
+    assert {w["band"] for r in default_regions for w in r["windows"]} == set(acc.PIPELINES["default"]["landmark_bands"])
     bogus = acc.reporting_jobs(1, pipelines={"bogus": {**trace_pipeline, "input": "video"}}, cells=acc.CELLS[3:4])
     with pytest.raises(ValueError, match="map input 'video' is not one of"):
         run_job(bogus[0])

@@ -10,7 +10,6 @@ from swarmtopo.readers.paper import PAPER_THETA, betti_function
 from swarmtopo.experiments.clust import HOLES, SCALES, clust_sweeps
 from swarmtopo.experiments.reproduce import reproduce
 from swarmtopo.experiments.store import read_jobs
-from swarmtopo.topology.persistence import Diagram
 
 
 def test_sweeps_share_the_two_hole_scale_one_test_set_and_not_the_training_set():
@@ -37,7 +36,7 @@ def test_tiny_clust_table_matches_its_store(tmp_path):
     for holes in HOLES:
         maps = [r for r in store if r["holes"] == holes and r["scale"] == 1.0 and r["salt"] == "clust-test"
                 and r["error"] is None]
-        estimates = [betti_function(Diagram.from_json(r["diagrams"][0]["diagram"]).lengths(1), q, delta, tau)
+        estimates = [betti_function(r["diagrams"][0]["diagram"].lengths(1), q, delta, tau)
                      for r in maps]
         row = paper[f"holes={holes}"]
         assert int(row["maps"]) == len(maps)

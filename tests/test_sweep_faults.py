@@ -139,7 +139,7 @@ def test_poison_jobs_are_rows_the_sweep_goes_on_and_retry_failed_reruns_them(tmp
     jobs = cheap_jobs("poison", 6, salt="poison")
     store = tmp_path / "s.duckdb"
     calls = []
-    summary = run_sweep(jobs, store, scheduler=cluster, job_timeout=8.0, runner=sweep_faults.faulty_job,
+    summary = run_sweep(jobs, store, scheduler=cluster, job_timeout=5.0, runner=sweep_faults.faulty_job,
                         progress=lambda *a: calls.append(a))
     assert calls[0] == (0, 6, 0) and calls[-1][:2] == (6, 6), read_jobs(store, columns=("key", "error"))  # the total is known before the cluster is used
     assert (summary.run, summary.failed, summary.workers) == (6, {"crashed": 1, "error": 1, "timeout": 1}, 2), \
@@ -147,7 +147,7 @@ def test_poison_jobs_are_rows_the_sweep_goes_on_and_retry_failed_reruns_them(tmp
     rows = {row["replicate"]: row for row in read_jobs(store)}
     assert rows[0]["status"] == "crashed" and "killed by SIGKILL" in rows[0]["error"]
     assert (rows[1]["status"], rows[1]["error"]) == ("error", "ZeroDivisionError: a bug over two lines")
-    assert rows[2]["status"] == "timeout" and rows[2]["error"].startswith("ran past the job timeout of 8 s")
+    assert rows[2]["status"] == "timeout" and rows[2]["error"].startswith("ran past the job timeout of 5 s")
     for r in (0, 1, 2):
         assert rows[r]["est_betti1"] is None and rows[r]["true_betti1"] is None and rows[r]["diagrams"] is None
     reference = {job.key: plain(run_job(job)) for job in jobs}
@@ -223,7 +223,8 @@ def sweep_file(tmp_path_factory):
     return path
 
 
-def test_an_unreachable_scheduler_is_one_line_and_creates_no_store(tmp_path, sweep_file):
+def test_an_unreachable_scheduler_is_one_line_and_creates_no_store(tmp_path, sweep_file, monkeypatch):
+    monkeypatch.setattr("swarmtopo.pipeline.engine.CONNECT_TIMEOUT", 2.0)  # the CLI runs in this process
     address = f"tcp://127.0.0.1:{free_port()}"
     proc = run_cli("sweep", sweep_file, "--store", tmp_path / "r.duckdb", "--scheduler", address)
     assert proc.returncode == 1 and "Traceback" not in proc.stderr

@@ -15,7 +15,7 @@ from swarmtopo.topology.persistence import Diagram
 def row(true_b0, true_b1, est_b0, h1_lengths, error=None):
     def dgm(lengths):
         return Diagram(pairs=(np.array([[0.0, np.inf]]), np.array([[1.0, 1.0 + l] for l in lengths]).reshape(-1, 2)),
-                       backend="test").to_json()
+                       backend="test")
     return {"error": error, "true_betti0": true_b0, "true_betti1": true_b1, "est_betti0": est_b0,
             "diagrams": None if error else [{"events": 500, "diagram": dgm(h1_lengths)},
                                             {"events": 60, "diagram": dgm([99.0])}]}

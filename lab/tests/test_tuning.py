@@ -184,7 +184,7 @@ def test_maps_know_their_regions_spans_and_their_features_carry_the_span():
     rng = np.random.default_rng(6)
     (one,) = synthetic_maps(1, rng)
     row = {"error": None, "est_betti0": 1, "true_betti0": 1, "true_betti1": one.true_betti1, "config": {},
-           "diagrams": [{"windows": [{"t0": 2.0 + 10 * k, "t1": 17.0 + 10 * k, "band": band, "diagram": w.to_json()}
+           "diagrams": [{"windows": [{"t0": 2.0 + 10 * k, "t1": 17.0 + 10 * k, "band": band, "diagram": w}
                                      for k, w in enumerate(one.regions[0]) for band in (1.0, 0.5)]}]}
     (read,) = maps_from_rows([row], lambda config: "c")
     assert read.spans == (35.0,) and len(read.regions) == 1 and len(read.regions[0]) == 6

@@ -1,0 +1,175 @@
+"""The sweep store at scale: row size, write and read rates, and a 10^5-job sweep end to end.
+
+1. Realistic rows: ``--realistic`` jobs of 200 agents x 120 s (random arenas, 1-3 square
+   holes; the default map), each run once with every window's diagram kept.  Bytes per
+   row of its ``diagrams``: the JSON text the store held before (``Diagram.to_json`` of
+   every region and window), and the compressed BLOB for each ``[sweep] diagrams`` level.
+   Then bytes per row on disk: ``--copies`` copies of each row (distinct keys) written to
+   a fresh store per level, file size / rows, extrapolated to 100,000 rows.
+2. Writing: the same rows written one transaction per row on a held connection with the
+   JSON column (what the store did before; the baseline) and in batches of
+   ``FLUSH_ROWS`` with the BLOB (``ResultStore.write``): rows per second and the ratio.
+3. Reading: every row streamed back with ``iter_jobs`` (all columns, diagrams decoded):
+   rows per second and the peak memory above the start, against the store's size.
+4. ``--jobs N`` (default 100,000; 0 skips it): a sweep of N cheap jobs (1 agent for 1 s:
+   a real simulate-and-map job that stops at "too little data", about 9 ms) on the local
+   cluster (``--workers``, default 2): wall time, jobs per minute, the peak resident
+   memory of this process (the client, with the local cluster's scheduler in it), and the
+   store's size.
+
+    python benchmarks/bench_store.py [--realistic 6] [--copies 50] [--jobs 100000] [--workers 2]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from _measure import machine, revision, run_measured
+from swarmtopo.experiments.grid import KEEP_LEVELS, expand_grid
+from swarmtopo.experiments.store import (
+    JOB_COLUMNS, ResultStore, decode_regions, encode_regions, iter_jobs,
+)
+from swarmtopo.experiments.sweep import FLUSH_ROWS, run_job, run_sweep
+from swarmtopo.topology.persistence import Diagram
+
+SCALE = 100_000
+
+
+def realistic_jobs(n: int):
+    grid = {"sweep": {"name": "realistic", "replicates": n, "salt": "bench-store"},
+            "arena": {"holes": [1, 2, 3]}, "swarm": {"agents": 200, "duration": 120.0}}
+    return expand_grid(grid).jobs[:n]
+
+
+def kept(regions, keep: str):
+    """The regions with only the diagrams ``keep`` keeps."""
+    return [{**{k: v for k, v in r.items() if k not in ("diagram", "windows")},
+             "windows": [{k: v for k, v in w.items() if k != "diagram" or keep == "windows"} for w in r["windows"]],
+             **({"diagram": r["diagram"]} if keep != "none" else {})} for r in regions]
+
+
+def old_json(regions) -> str:
+    """The diagrams column as the store wrote it before: JSON, each Diagram as to_json."""
+    return json.dumps(regions, sort_keys=True, allow_nan=False,
+                      default=lambda x: x.to_json() if isinstance(x, Diagram) else x)
+
+
+def copies(rows, n: int, keep: str):
+    """n copies of each row with distinct keys, diagrams kept at ``keep``."""
+    out = []
+    for row in rows:
+        blob = encode_regions(kept(decode_regions(row["diagrams"]), keep))
+        for i in range(n):
+            out.append({**row, "key": f"{row['key']}-{i}", "diagrams": blob, "diagrams_kept": keep})
+    return out
+
+
+def per_row_baseline(rows, path: Path) -> float:
+    """Seconds to write rows one transaction each on a held connection, diagrams as JSON text."""
+    import duckdb
+
+    names = [name for name, _ in JOB_COLUMNS]
+    columns = ", ".join(f'"{n}" {"JSON" if n == "diagrams" else sql}' for n, sql in JOB_COLUMNS)
+    with duckdb.connect(str(path)) as db:
+        db.execute(f"CREATE TABLE jobs ({columns})")
+        insert = f"INSERT INTO jobs VALUES ({', '.join('?' * len(names))})"
+        start = time.perf_counter()
+        for row in rows:
+            values = dict(row, diagrams=old_json(decode_regions(row["diagrams"])))
+            db.execute(insert, [json.dumps(values[n], sort_keys=True) if n in ("config", "versions") else values[n]
+                                for n in names])
+        return time.perf_counter() - start
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--realistic", type=int, default=6, help="realistic jobs run (default 6)")
+    parser.add_argument("--copies", type=int, default=50, help="copies of each written per store (default 50)")
+    parser.add_argument("--jobs", type=int, default=SCALE, help="cheap jobs of the end-to-end sweep (0: skip)")
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--sweep-only", action="store_true", help=argparse.SUPPRESS)  # part 4 in a fresh process
+    args = parser.parse_args()
+    if args.sweep_only:
+        cheap_sweep(args.jobs, args.workers)
+        return
+    print(f"# bench_store  {revision()}  {machine()}\n")
+
+    jobs = realistic_jobs(args.realistic)
+    start = time.perf_counter()
+    rows = [run_job(job, "windows") for job in jobs]
+    assert all(row["status"] == "ok" for row in rows)
+    print(f"1. {len(rows)} realistic rows (200 agents x 120 s, 1-3 holes): "
+          f"{(time.perf_counter() - start) / len(rows):.1f} s per job")
+    regions = [decode_regions(row["diagrams"]) for row in rows]
+    sizes = {"JSON before (every window)": [len(old_json(r).encode()) for r in regions]}
+    for keep in KEEP_LEVELS:
+        sizes[f"BLOB, diagrams = {keep!r}"] = [len(encode_regions(kept(r, keep))) for r in regions]
+    for name, values in sizes.items():
+        print(f"   diagrams column, {name:<30} {statistics.median(values) / 1e3:9.1f} KB per row (median)")
+
+    with tempfile.TemporaryDirectory() as tmp:
+        print(f"\n   on disk ({args.copies} copies of each row per store, DuckDB file size / rows):")
+        for keep in KEEP_LEVELS:
+            path = Path(tmp) / f"{keep}.duckdb"
+            batch = copies(rows, args.copies, keep)
+            store = ResultStore(path)
+            for i in range(0, len(batch), FLUSH_ROWS):
+                assert store.write(batch[i:i + FLUSH_ROWS])
+            per_row = path.stat().st_size / len(batch)
+            print(f"   diagrams = {keep!r:<10} {per_row / 1e3:8.1f} KB per row -> "
+                  f"{per_row * SCALE / 1e9:6.2f} GB for {SCALE:,} rows")
+
+        batch = copies(rows, args.copies, "map")
+        baseline = per_row_baseline(batch, Path(tmp) / "baseline.duckdb")
+        store = ResultStore(Path(tmp) / "batched.duckdb")
+        start = time.perf_counter()
+        for i in range(0, len(batch), FLUSH_ROWS):
+            assert store.write(batch[i:i + FLUSH_ROWS])
+        batched = time.perf_counter() - start
+        print(f"\n2. writing {len(batch)} rows (diagrams = 'map'): one transaction per row, JSON "
+              f"{len(batch) / baseline:7.0f} rows/s; batches of {FLUSH_ROWS}, BLOB {len(batch) / batched:7.0f} rows/s "
+              f"({baseline / batched:.1f}x)")
+
+        path = Path(tmp) / "windows.duckdb"
+        count, seconds, peak, _ = run_measured(lambda: sum(1 for _ in iter_jobs(path)))
+        print(f"\n3. streaming {count} rows back (every column, every window's diagram decoded): "
+              f"{count / seconds:.0f} rows/s, peak {peak / 1e6:.0f} MB above the start "
+              f"for a {path.stat().st_size / 1e6:.0f} MB store")
+
+    if args.jobs:  # a fresh process, so that its peak memory is the sweep's alone
+        subprocess.run([sys.executable, __file__, "--sweep-only", "--jobs", str(args.jobs),
+                        "--workers", str(args.workers)], check=True)
+
+
+def cheap_sweep(n: int, workers: int) -> None:
+    grid = {"sweep": {"name": "cheap", "replicates": n, "salt": "bench-store"},
+            "swarm": {"agents": 1, "duration": 1.0}}
+    cheap = expand_grid(grid).jobs
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "cheap.duckdb"
+        summary, wall, _, _ = run_measured(lambda: run_sweep(cheap, path, workers=workers))
+        assert summary.run == n
+        peak = _peak_rss_mb()
+        size = path.stat().st_size
+        alone = statistics.median(r["t_total"] for r in iter_jobs(path, columns=("key", "t_total")))
+    print(f"\n4. {n:,} cheap jobs on {workers} local workers: {wall / 60:.1f} min, {60 * n / wall:,.0f} jobs/min; "
+          f"client peak RSS {peak:.0f} MB (the whole process: the client and the local cluster's scheduler); "
+          f"store {size / 1e6:.1f} MB ({size / n:.0f} B per row); one job alone {alone * 1e3:.1f} ms (median)")
+
+
+def _peak_rss_mb() -> float:
+    with open("/proc/self/status") as status:
+        for line in status:
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1e3
+    return float("nan")
+
+if __name__ == "__main__":
+    main()
