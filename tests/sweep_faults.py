@@ -54,3 +54,10 @@ def sleep_for(seconds):
 def shout(x):
     print("a library printing to stdout")
     return x
+
+
+def kills_worker_at_15(job, keep):
+    """run_job, except replicate 15 of a "chunk-kill" sweep, which kills its Dask worker."""
+    if job.salt == "chunk-kill" and job.replicate == 15:
+        worker_killer(job, keep)
+    return run_job(job, keep)

@@ -172,6 +172,31 @@ def test_a_job_that_kills_its_workers_is_a_crashed_row(tmp_path, importable_test
     assert row["status"] == "crashed" and row["error"].startswith("its workers died running it (KilledWorker")
 
 
+def test_jobs_per_task_grow_as_jobs_prove_cheap():
+    from swarmtopo.experiments.sweep import MAX_JOBS_PER_TASK, TASK_SECONDS, _jobs_per_task
+
+    assert _jobs_per_task([]) == _jobs_per_task([0.001] * 7) == 1  # one job per task until 8 are timed
+    assert _jobs_per_task([0.01] * 8) == int(TASK_SECONDS / 0.01)
+    assert _jobs_per_task([1e-6] * 8) == MAX_JOBS_PER_TASK and _jobs_per_task([2.0] * 100) == 1
+
+
+@pytest.mark.slow
+def test_a_worker_killer_inside_a_task_of_many_jobs_is_the_only_crashed_row(tmp_path, importable_tests, monkeypatch):
+    import dask
+
+    monkeypatch.setattr("swarmtopo.experiments.sweep.IN_FLIGHT", 1)  # 4 tasks in flight: later jobs share tasks
+    jobs = expand_grid({"sweep": {"name": "chunks", "replicates": 20, "salt": "chunk-kill"},
+                        "swarm": {"agents": 1, "duration": 1.0}}).jobs
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        summary = run_sweep(jobs, tmp_path / "s.duckdb", workers=1, runner=sweep_faults.kills_worker_at_15)
+    assert (summary.run, summary.failed) == (20, {"crashed": 1, "error": 19})  # 1 agent: "too little data"
+    rows = read_jobs(tmp_path / "s.duckdb")
+    (crashed,) = [row for row in rows if row["status"] == "crashed"]
+    assert crashed["replicate"] == 15
+    assert {row["key"]: plain(row) for row in rows if row is not crashed} == \
+        {job.key: plain(run_job(job)) for job in jobs if job.replicate != 15}
+
+
 def _cli_sweep(toml, store, *extra):
     return subprocess.Popen([sys.executable, "-m", "swarmtopo", "sweep", str(toml), "--store", str(store),
                              "--verbose", *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,

@@ -25,14 +25,14 @@ import logging
 import os
 import socket
 import tempfile
+import statistics
 import threading
 import time
-from collections import Counter
+from collections import Counter, deque
 from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass, field, replace
 from datetime import datetime, timezone
 from functools import lru_cache
-from itertools import islice
 from typing import Any, Callable, Iterable
 
 from ..arena import Arena, annulus_arena, default_arena, random_arena, square_arena, two_rooms_arena
@@ -213,19 +213,21 @@ def _identity_row(job: Job) -> dict[str, Any]:
 _PROCESSES = threading.local()
 
 
-def run_isolated(job: Job, keep: str, timeout: float | None, runner: Callable[[Job, str], dict] = run_job
-                 ) -> dict[str, Any]:
-    """The Dask task of a job: ``runner(job, keep)`` in this worker thread's child process
-    (:class:`~.isolation.JobProcess`), its row; a failed row if the call raised
-    ("error"), its process died ("crashed") or it ran past ``timeout`` s ("timeout")."""
+def run_isolated(jobs: list[Job], keep: str, timeout: float | None,
+                 runner: Callable[[Job, str], dict] = run_job) -> list[dict[str, Any]]:
+    """The Dask task of a few jobs: each ``runner(job, keep)`` in turn in this worker
+    thread's child process (:class:`~.isolation.JobProcess`); their rows, a failed row
+    for a call that raised ("error"), whose process died ("crashed") or that ran past
+    ``timeout`` s ("timeout")."""
     process = getattr(_PROCESSES, "process", None)
     if process is None:
         process = _PROCESSES.process = JobProcess(warm_up)
-    start = time.perf_counter()
-    kind, value = process.call(_call_runner, (runner, job, keep), timeout)
-    if kind == "ok":
-        return value
-    return failed_row(job, kind, value, time.perf_counter() - start)
+    rows = []
+    for job in jobs:
+        start = time.perf_counter()
+        kind, value = process.call(_call_runner, (runner, job, keep), timeout)
+        rows.append(value if kind == "ok" else failed_row(job, kind, value, time.perf_counter() - start))
+    return rows
 
 
 def _call_runner(args):
@@ -447,27 +449,46 @@ class _Batches:
 
 
 def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, timeout, runner, address) -> None:
-    """Submit the jobs in a bounded window, collect each row as it finishes (a failed row
-    for a job whose workers died), until all are written or something stops the sweep."""
+    """Submit the jobs a window at a time, collect the rows as tasks finish, until all are
+    written or something stops the sweep.
+
+    A task runs one job at first, then as many as take about ``TASK_SECONDS`` at the
+    median job time seen so far (at most ``MAX_JOBS_PER_TASK``): cheap jobs do not pay
+    Dask's per-task cost each.  A task whose workers died (Dask's KilledWorker) is split
+    into its jobs, each run alone, and a job whose workers died when it ran alone is run
+    alone once more: a job that merely shared a dying worker with the culprit finishes,
+    and only the job that kills its workers again becomes a "crashed" row.
+    """
     from concurrent.futures import CancelledError
 
     from distributed import as_completed
     from distributed.scheduler import KilledWorker
 
-    queue = iter(pending)
-    window = max(IN_FLIGHT, 4 * sum(client.nthreads().values()))
-    running: dict[str, tuple[Any, Job]] = {}  # task key -> (future, job)
+    # (job, None) may share a task; (job, n) runs alone, its workers having died n times when it did
+    queue: deque[tuple[Job, int | None]] = deque((job, None) for job in pending)
+    jobs_left = len(pending)  # jobs without a row yet
+    window = max(IN_FLIGHT, 4 * sum(client.nthreads().values()))  # tasks in flight at most
+    running: dict[str, tuple[Any, list[Job], int | None]] = {}  # task key -> (future, its jobs, deaths)
+    seconds: list[float] = []  # the finished jobs' t_total
     finished = as_completed()
 
-    def submit(n: int) -> None:
-        chunk = list(islice(queue, n))
-        if chunk:
-            futures = client.map(run_isolated, chunk, key=[f"swarmtopo-job-{job.key}" for job in chunk],
+    def submit() -> None:
+        size = _jobs_per_task(seconds)
+        tasks = []
+        while queue and len(running) + len(tasks) < window:
+            job, deaths = queue.popleft()
+            task = [job]
+            while deaths is None and len(task) < size and queue and queue[0][1] is None:
+                task.append(queue.popleft()[0])
+            tasks.append((task, deaths))
+        if tasks:
+            futures = client.map(run_isolated, [task for task, _ in tasks],
+                                 key=[f"swarmtopo-jobs-{task[0].key}-{len(task)}-{deaths}" for task, deaths in tasks],
                                  keep=keep, timeout=timeout, runner=runner)
-            running.update((future.key, (future, job)) for future, job in zip(futures, chunk))
+            running.update((future.key, (future, *task)) for future, task in zip(futures, tasks))
             finished.update(futures)
 
-    submit(window)
+    submit()
     try:
         with deferred_interrupt() as interrupted:
             while running:
@@ -476,26 +497,37 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
                 done = finished.next_batch(block=False)
                 if not done:
                     if client.status != "running":
-                        raise SchedulerLost(address, batch.done, len(running) + _left(queue), "connection closed")
+                        raise SchedulerLost(address, batch.done, jobs_left, "connection closed")
                     time.sleep(POLL_SECONDS)
                     if time.monotonic() - batch.last >= FLUSH_SECONDS:
                         batch.flush()
                 for future in done:
-                    _, job = running.pop(future.key)
+                    _, task, deaths = running.pop(future.key)
                     try:
-                        row = future.result()
+                        rows = future.result()
                     except KilledWorker as exc:
-                        row = failed_row(job, "crashed", f"its workers died running it ({one_line(exc)})")
+                        future.release()
+                        if len(task) > 1:  # which of them? each alone
+                            queue.extendleft((job, 0) for job in reversed(task))
+                            continue
+                        if not deaths:  # alone, once more
+                            queue.appendleft((task[0], (deaths or 0) + 1))
+                            continue
+                        rows = [failed_row(task[0], "crashed", f"its workers died running it ({one_line(exc)})")]
                     except CancelledError:
-                        raise SchedulerLost(address, batch.done, len(running) + 1 + _left(queue),
+                        raise SchedulerLost(address, batch.done, jobs_left,
                                             "its tasks were cancelled: scheduler-connection-lost") from None
-                    except Exception as exc:  # noqa: BLE001 - a job's own failure is its row
-                        row = failed_row(job, "error", one_line(exc))
+                    except Exception as exc:  # noqa: BLE001 - a task's own failure is its jobs' rows
+                        rows = [failed_row(job, "error", one_line(exc)) for job in task]
                     future.release()
-                    batch.add(row)
+                    for row in rows:
+                        batch.add(row)
+                        jobs_left -= 1
+                        if row["t_total"] is not None:
+                            seconds.append(row["t_total"])
                     say(batch.done, len(pending), sum(batch.failed.values()))
                 if len(running) < window // 2:
-                    submit(window - len(running))
+                    submit()
         batch.outcome = "finished"
     except SchedulerLost:
         batch.outcome = "scheduler lost"
@@ -505,13 +537,21 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
             client.cancel([future for future, _ in running.values()])
 
 
-IN_FLIGHT = 256
-"""Jobs submitted ahead at least (four per worker thread if more): the scheduler holds a
+IN_FLIGHT = 64
+"""Tasks submitted ahead at least (four per worker thread if more): the scheduler holds a
 window of the sweep, not all of it, so a 10^5-job sweep costs the client little memory."""
+TASK_SECONDS = 0.5
+"""Seconds of jobs a task aims at (at the median job time seen so far)."""
+MAX_JOBS_PER_TASK = 64
 
 
-def _left(queue) -> int:
-    return sum(1 for _ in queue)
+def _jobs_per_task(seconds: list[float]) -> int:
+    """Jobs per task: 1 until 8 jobs have finished, then TASK_SECONDS at the median time
+    of the last 256."""
+    if len(seconds) < 8:
+        return 1
+    median = statistics.median(seconds[-256:])
+    return int(min(MAX_JOBS_PER_TASK, max(1, TASK_SECONDS / max(median, 1e-3))))
 
 
 def _worker_count(client, default: int = 0) -> int:
