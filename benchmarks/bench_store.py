@@ -1,23 +1,26 @@
 """The sweep store at scale: row size, write and read rates, and a 10^5-job sweep end to end.
 
 1. Realistic rows: ``--realistic`` jobs of 200 agents x 120 s (random arenas, 1-3 square
-   holes; the default map), each run once with every window's diagram kept.  Bytes per
-   row of its ``diagrams``: the JSON text the store held before (``Diagram.to_json`` of
-   every region and window), and the compressed BLOB for each ``[sweep] diagrams`` level.
-   Then bytes per row on disk: ``--copies`` copies of each row (distinct keys) written to
-   a fresh store per level, file size / rows, extrapolated to 100,000 rows.
-2. Writing: the same rows written one transaction per row on a held connection with the
-   JSON column (what the store did before; the baseline) and in batches of
-   ``FLUSH_ROWS`` with the BLOB (``ResultStore.write``): rows per second and the ratio.
-3. Reading: every row streamed back with ``iter_jobs`` (all columns, diagrams decoded):
-   rows per second and the peak memory above the start, against the store's size.
-4. ``--jobs N`` (default 100,000; 0 skips it): a sweep of N cheap jobs (1 agent for 1 s:
-   a real simulate-and-map job that stops at "too little data", about 9 ms) on the local
-   cluster (``--workers``, default 2): wall time, jobs per minute, the peak resident
-   memory of this process (the client, with the local cluster's scheduler in it), and the
-   store's size.
+   holes; the default map) swept on the local cluster with every window's diagram kept.
+   Bytes per row of its ``diagrams``: the JSON text the store held before
+   (``Diagram.to_json`` of every region and window) and the compressed BLOB for each
+   ``[sweep] diagrams`` level.  Then bytes per row on disk for each level: the rows
+   written to a fresh store in two halves, the file's growth over the second half per
+   row (DuckDB's fixed overhead aside), extrapolated to 100,000 rows.
+2. Writing: ``--copies`` copies of each row (distinct keys; level "map") written one
+   transaction per row on a held connection with the diagrams as JSON text (what the
+   store did before; the baseline) and in batches of ``FLUSH_ROWS`` with the BLOB
+   (``ResultStore.write``): rows per second and the ratio.
+3. Reading: the level-"windows" store streamed back with ``iter_jobs`` (every column,
+   every diagram decoded): rows per second and the peak memory above the start, against
+   the size of all its decoded diagrams.
+4. ``--jobs N`` (default 100,000; 0 skips it), in a fresh process: a sweep of N cheap
+   jobs (1 agent for 1 s: a real simulate-and-map job that stops at "too little data")
+   on the local cluster (``--workers``, default 2): wall time, jobs per minute, the peak
+   resident memory of the process (the client, with the local cluster's scheduler in
+   it), and the store's size.
 
-    python benchmarks/bench_store.py [--realistic 6] [--copies 50] [--jobs 100000] [--workers 2]
+    python benchmarks/bench_store.py [--realistic 24] [--copies 20] [--jobs 100000] [--workers 2]
 """
 
 from __future__ import annotations
@@ -33,10 +36,8 @@ from pathlib import Path
 
 from _measure import machine, revision, run_measured
 from swarmtopo.experiments.grid import KEEP_LEVELS, expand_grid
-from swarmtopo.experiments.store import (
-    JOB_COLUMNS, ResultStore, decode_regions, encode_regions, iter_jobs,
-)
-from swarmtopo.experiments.sweep import FLUSH_ROWS, run_job, run_sweep
+from swarmtopo.experiments.store import JOB_COLUMNS, ResultStore, decode_regions, encode_regions, iter_jobs
+from swarmtopo.experiments.sweep import FLUSH_ROWS, run_sweep
 from swarmtopo.topology.persistence import Diagram
 
 SCALE = 100_000
@@ -90,8 +91,8 @@ def per_row_baseline(rows, path: Path) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--realistic", type=int, default=6, help="realistic jobs run (default 6)")
-    parser.add_argument("--copies", type=int, default=50, help="copies of each written per store (default 50)")
+    parser.add_argument("--realistic", type=int, default=24, help="realistic jobs run (default 24)")
+    parser.add_argument("--copies", type=int, default=20, help="copies of each row written in part 2 (default 20)")
     parser.add_argument("--jobs", type=int, default=SCALE, help="cheap jobs of the end-to-end sweep (0: skip)")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--sweep-only", action="store_true", help=argparse.SUPPRESS)  # part 4 in a fresh process
@@ -101,32 +102,39 @@ def main() -> None:
         return
     print(f"# bench_store  {revision()}  {machine()}\n")
 
-    jobs = realistic_jobs(args.realistic)
-    start = time.perf_counter()
-    rows = [run_job(job, "windows") for job in jobs]
-    assert all(row["status"] == "ok" for row in rows)
-    print(f"1. {len(rows)} realistic rows (200 agents x 120 s, 1-3 holes): "
-          f"{(time.perf_counter() - start) / len(rows):.1f} s per job")
-    regions = [decode_regions(row["diagrams"]) for row in rows]
-    sizes = {"JSON before (every window)": [len(old_json(r).encode()) for r in regions]}
-    for keep in KEEP_LEVELS:
-        sizes[f"BLOB, diagrams = {keep!r}"] = [len(encode_regions(kept(r, keep))) for r in regions]
-    for name, values in sizes.items():
-        print(f"   diagrams column, {name:<30} {statistics.median(values) / 1e3:9.1f} KB per row (median)")
-
     with tempfile.TemporaryDirectory() as tmp:
-        print(f"\n   on disk ({args.copies} copies of each row per store, DuckDB file size / rows):")
+        source = Path(tmp) / "realistic.duckdb"
+        start = time.perf_counter()
+        summary = run_sweep(realistic_jobs(args.realistic), source, workers=args.workers, keep="windows")
+        assert summary.run == args.realistic and not summary.failed
+        rows = list(iter_jobs(source))
+        print(f"1. {len(rows)} realistic rows (200 agents x 120 s, 1-3 holes, every window's diagram kept), "
+              f"mapped in {time.perf_counter() - start:.0f} s on {args.workers} workers")
+        regions = [row["diagrams"] for row in rows]
+        sizes = {"JSON before (every window)": [len(old_json(r).encode()) for r in regions]}
+        for keep in KEEP_LEVELS:
+            sizes[f"BLOB, diagrams = {keep!r}"] = [len(encode_regions(kept(r, keep))) for r in regions]
+        for name, values in sizes.items():
+            print(f"   diagrams column, {name:<30} {statistics.median(values) / 1e3:9.1f} KB per row (median)")
+
+        print("\n   on disk (each row once: the file's growth from the first half of the rows to all of them, "
+              "per row added):")
         for keep in KEEP_LEVELS:
             path = Path(tmp) / f"{keep}.duckdb"
-            batch = copies(rows, args.copies, keep)
             store = ResultStore(path)
-            for i in range(0, len(batch), FLUSH_ROWS):
-                assert store.write(batch[i:i + FLUSH_ROWS])
-            per_row = path.stat().st_size / len(batch)
+            level = [dict(row, diagrams=encode_regions(kept(r, keep)), diagrams_kept=keep,
+                          config=row["config"], versions=row["versions"]) for row, r in zip(rows, regions)]
+            half = len(level) // 2
+            assert store.write(level[:half])
+            size_half = path.stat().st_size
+            assert store.write(level[half:])
+            per_row = (path.stat().st_size - size_half) / (len(level) - half)
             print(f"   diagrams = {keep!r:<10} {per_row / 1e3:8.1f} KB per row -> "
                   f"{per_row * SCALE / 1e9:6.2f} GB for {SCALE:,} rows")
 
-        batch = copies(rows, args.copies, "map")
+        raw = [dict(row, diagrams=encode_regions(kept(r, "map")), diagrams_kept="map")
+               for row, r in zip(rows, regions)]
+        batch = copies(raw, args.copies, "map")
         baseline = per_row_baseline(batch, Path(tmp) / "baseline.duckdb")
         store = ResultStore(Path(tmp) / "batched.duckdb")
         start = time.perf_counter()
@@ -139,9 +147,10 @@ def main() -> None:
 
         path = Path(tmp) / "windows.duckdb"
         count, seconds, peak, _ = run_measured(lambda: sum(1 for _ in iter_jobs(path)))
+        decoded = sum(p.nbytes for r in regions for reg in r for w in reg["windows"] for p in w["diagram"].pairs)
         print(f"\n3. streaming {count} rows back (every column, every window's diagram decoded): "
-              f"{count / seconds:.0f} rows/s, peak {peak / 1e6:.0f} MB above the start "
-              f"for a {path.stat().st_size / 1e6:.0f} MB store")
+              f"{count / seconds:.0f} rows/s, peak {peak / 1e6:.0f} MB above the start, for "
+              f"{decoded / 1e6:.0f} MB of decoded diagrams ({path.stat().st_size / 1e6:.0f} MB store)")
 
     if args.jobs:  # a fresh process, so that its peak memory is the sweep's alone
         subprocess.run([sys.executable, __file__, "--sweep-only", "--jobs", str(args.jobs),

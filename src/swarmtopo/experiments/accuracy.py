@@ -420,7 +420,7 @@ def run_benchmark(store, *, quick: bool = False, scheduler: str | None = None, w
     Each pipeline's maps are read by its shipped classifier (:func:`outcomes`);
     ``paper-theta`` is the paper pipeline's maps read by the paper's published Theta*.
     """
-    from .store import job_rows_each
+    from .store import iter_jobs
     from .sweep import run_sweep
 
     per_cell = per_cell or (QUICK_PER_CELL if quick else REPORTING_PER_CELL)
@@ -428,14 +428,25 @@ def run_benchmark(store, *, quick: bool = False, scheduler: str | None = None, w
     planning = planning_jobs(planning_per_cell, planning_cells) if planning_per_cell else []
     summary = run_sweep(jobs + planning, store, scheduler=scheduler, workers=workers, progress=progress,
                         keep="windows")
-    rows, planning_rows = job_rows_each(store, jobs, planning)
-    by_pipeline = {name: [r for r in rows if _pipeline_of(r["config"]) == name] for name in PIPELINES}
     classifiers = {name: load_classifier(PIPELINES[name]["classifier"]) for name in PIPELINES}
-    results = {name: outcomes(subset, classifiers[name]) for name, subset in by_pipeline.items()}
-    results["paper-theta"] = outcomes(by_pipeline["paper"], published_paper_classifier())
-    planning_records = outcomes(planning_rows, classifiers["default"], cells=planning_cells)
+    paper_theta = published_paper_classifier()
+    results: dict[str, list] = {name: [] for name in (*PIPELINES, "paper-theta")}
+    planning_records: list = []
+    planning_keys = {job.key for job in planning}
+    maps = 0
+    # one row in memory at a time (every window's diagrams), in key order as each list was
+    for row in iter_jobs(store, keys=[job.key for job in jobs + planning]):
+        if row["key"] in planning_keys:
+            planning_records += outcomes([row], classifiers["default"], cells=planning_cells)
+            continue
+        maps += 1
+        name = _pipeline_of(row["config"])
+        if name is not None:
+            results[name] += outcomes([row], classifiers[name])
+        if name == "paper":
+            results["paper-theta"] += outcomes([row], paper_theta)
     return {
-        "suite": SUITE, "cases_per_cell": per_cell, "maps": len(rows),
+        "suite": SUITE, "cases_per_cell": per_cell, "maps": maps,
         "seconds": summary.seconds, "jobs_run": summary.run, "workers": summary.workers,
         "pipelines": {name: {"table": {k: (v.to_json() if isinstance(v, Rate) else {c: r.to_json() for c, r in v.items()})
                                        for k, v in accuracy_table(recs).items()},

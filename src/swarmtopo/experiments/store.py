@@ -35,7 +35,7 @@ Writing and reading.  The sweep's client holds the file only while it writes a b
 of rows (one transaction: after a crash a batch is there whole or not at all), so
 another process can read the store while a sweep runs (``swarmtopo status``,
 :func:`iter_jobs`); either side waits its turn when the other holds the file.
-:func:`iter_jobs` streams rows in Arrow batches and decodes only the columns asked for.
+:func:`iter_jobs` streams rows a batch at a time and reads only the columns asked for.
 """
 
 from __future__ import annotations
@@ -304,8 +304,9 @@ def _arrow_types() -> dict:
 # -- reading ------------------------------------------------------------------------------
 def iter_jobs(path, *, sweep: str | None = None, keys: Iterable[str] | None = None,
               columns: Sequence[str] | None = None, status: str | None = None,
-              batch_rows: int = 256) -> Iterator[dict[str, Any]]:
-    """Stream the rows of a result store as dicts, sorted by key, ``batch_rows`` at a time.
+              batch_rows: int = 128) -> Iterator[dict[str, Any]]:
+    """Stream the rows of a result store as dicts, sorted by key, ``batch_rows`` at a time
+    (only the selected keys and one batch of rows are in memory at once).
 
     Parameters
     ----------
@@ -336,7 +337,6 @@ def iter_jobs(path, *, sweep: str | None = None, keys: Iterable[str] | None = No
         raise SwarmtopoError(f"{path}: no such result store")
     with _opened(path, read_only=True) as db:
         _check_schema(db, path, columns)
-        selected = "jobs.*" if columns is None else ", ".join(f'jobs."{name}"' for name in columns)
         where, params = [], []
         if sweep is not None:
             where.append("key IN (SELECT key FROM sweep_jobs WHERE sweep = ?)")
@@ -347,14 +347,18 @@ def iter_jobs(path, *, sweep: str | None = None, keys: Iterable[str] | None = No
         if status is not None:
             where.append("status = ?")
             params.append(status)
-        sql = f"SELECT {selected} FROM jobs" + (f" WHERE {' AND '.join(where)}" if where else "") + " ORDER BY key"
-        relation = db.sql(sql, params=params)
-        if hasattr(relation, "to_arrow_reader"):  # DuckDB 2
-            batches = relation.to_arrow_reader(batch_rows)
-        else:  # DuckDB 1.x
-            batches = db.execute(sql, params).fetch_record_batch(batch_rows)
-        for batch in batches:
-            for row in batch.to_pylist():
+        condition = f" WHERE {' AND '.join(where)}" if where else ""
+        # the keys first, sorted; then the rows a batch of keys at a time: sorting whole
+        # rows would hold every diagram in memory at once
+        selected_keys = [k for (k,) in db.execute(f"SELECT key FROM jobs{condition} ORDER BY key", params).fetchall()]
+        selected = "*" if columns is None else ", ".join(f'"{name}"' for name in columns)
+        for start in range(0, len(selected_keys), batch_rows):
+            chunk = selected_keys[start:start + batch_rows]
+            cursor = db.execute(f"SELECT {selected} FROM jobs WHERE key IN (SELECT unnest(?::TEXT[])) ORDER BY key",
+                                [chunk])
+            names = [d[0] for d in cursor.description]
+            for values in cursor.fetchall():
+                row = dict(zip(names, values))
                 for name in JSON_COLUMNS:
                     if row.get(name) is not None:
                         row[name] = json.loads(row[name])
