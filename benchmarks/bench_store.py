@@ -4,10 +4,11 @@
    holes; the default map) swept on the local cluster with every window's diagram kept.
    Bytes per row of its ``diagrams``: the JSON text the store held before
    (``Diagram.to_json`` of every region and window) and the compressed BLOB for each
-   ``[sweep] diagrams`` level.  Then bytes per row on disk for each level: the rows
-   written to a fresh store in two halves, the file's growth over the second half per
-   row (DuckDB's fixed overhead aside), extrapolated to 100,000 rows.
-2. Writing: ``--copies`` copies of each row (distinct keys; level "map") written one
+   ``[sweep] diagrams`` level.  Then bytes per row on disk for each level: ``--copies``
+   copies of each row (distinct keys, every value scaled by 1 + 1e-9 i so that no two
+   copies share one) written to a fresh store in two halves, the file's growth over the
+   second half per row (DuckDB's fixed overhead aside), extrapolated to 100,000 rows.
+2. Writing: the level-"map" copies of part 1 written one
    transaction per row on a held connection with the diagrams as JSON text (what the
    store did before; the baseline) and in batches of ``FLUSH_ROWS`` with the BLOB
    (``ResultStore.write``): rows per second and the ratio.
@@ -62,14 +63,28 @@ def old_json(regions) -> str:
                       default=lambda x: x.to_json() if isinstance(x, Diagram) else x)
 
 
-def copies(rows, n: int, keep: str):
-    """n copies of each row with distinct keys, diagrams kept at ``keep``."""
+def copies(rows, regions, n: int, keep: str):
+    """n copies of each row with distinct keys, diagrams kept at ``keep``, every bar and
+    H1 length scaled by 1 + 1e-9 i: no two copies share a value, so the store cannot
+    fold them together (DuckDB's dictionary compression would, and real rows differ)."""
     out = []
-    for row in rows:
-        blob = encode_regions(kept(decode_regions(row["diagrams"]), keep))
+    for row, region in zip(rows, regions):
         for i in range(n):
-            out.append({**row, "key": f"{row['key']}-{i}", "diagrams": blob, "diagrams_kept": keep})
+            factor = 1.0 + 1e-9 * i
+            blob = encode_regions(_scaled(kept(region, keep), factor))
+            out.append({**row, "key": f"{row['key']}-{i}", "diagrams": blob, "diagrams_kept": keep,
+                        "lengths_h1": [x * factor for x in row["lengths_h1"]]})
     return out
+
+
+def _scaled(item, factor: float):
+    if isinstance(item, Diagram):
+        return Diagram(tuple(p * factor for p in item.pairs), item.backend)
+    if isinstance(item, dict):
+        return {k: _scaled(v, factor) for k, v in item.items()}
+    if isinstance(item, list):
+        return [_scaled(v, factor) for v in item]
+    return item
 
 
 def per_row_baseline(rows, path: Path) -> float:
@@ -117,24 +132,23 @@ def main() -> None:
         for name, values in sizes.items():
             print(f"   diagrams column, {name:<30} {statistics.median(values) / 1e3:9.1f} KB per row (median)")
 
-        print("\n   on disk (each row once: the file's growth from the first half of the rows to all of them, "
-              "per row added):")
+        print(f"\n   on disk ({args.copies} copies of each row, their values scaled apart, per store; "
+              "the file's growth from the first half of the rows to all of them, per row added):")
         for keep in KEEP_LEVELS:
             path = Path(tmp) / f"{keep}.duckdb"
             store = ResultStore(path)
-            level = [dict(row, diagrams=encode_regions(kept(r, keep)), diagrams_kept=keep,
-                          config=row["config"], versions=row["versions"]) for row, r in zip(rows, regions)]
+            level = copies(rows, regions, args.copies, keep)
             half = len(level) // 2
-            assert store.write(level[:half])
-            size_half = path.stat().st_size
-            assert store.write(level[half:])
-            per_row = (path.stat().st_size - size_half) / (len(level) - half)
+            sizes = []
+            for part in (level[:half], level[half:]):
+                for i in range(0, len(part), FLUSH_ROWS):
+                    assert store.write(part[i:i + FLUSH_ROWS])
+                sizes.append(path.stat().st_size)
+            per_row = (sizes[1] - sizes[0]) / (len(level) - half)
             print(f"   diagrams = {keep!r:<10} {per_row / 1e3:8.1f} KB per row -> "
                   f"{per_row * SCALE / 1e9:6.2f} GB for {SCALE:,} rows")
 
-        raw = [dict(row, diagrams=encode_regions(kept(r, "map")), diagrams_kept="map")
-               for row, r in zip(rows, regions)]
-        batch = copies(raw, args.copies, "map")
+        batch = copies(rows, regions, args.copies, "map")
         baseline = per_row_baseline(batch, Path(tmp) / "baseline.duckdb")
         store = ResultStore(Path(tmp) / "batched.duckdb")
         start = time.perf_counter()

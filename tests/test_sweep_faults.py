@@ -68,20 +68,27 @@ bars = st.lists(st.tuples(st.floats(0, 1e6), st.one_of(st.floats(0, 1e6), st.jus
     lambda bl: (bl[0], bl[0] + bl[1])), max_size=20)  # (birth, birth + length)
 
 
-@given(st.lists(st.lists(bars, min_size=1, max_size=3), min_size=1, max_size=4))
-def test_diagrams_read_back_bit_for_bit(diagrams):
-    regions = [{"events": i, "window": 0.5 * i,
-                "windows": [{"t0": 0.0, "diagram": Diagram(tuple(np.array(p, dtype=float).reshape(-1, 2) for p in d),
-                                                           "test")}
-                            for d in diagrams], "diagram": Diagram((np.empty((0, 2)),), "test")}
-               for i in range(2)]
+def _diagram(pairs_per_dim):
+    return Diagram(tuple(np.array(p, dtype=float).reshape(-1, 2) for p in pairs_per_dim), "test")
+
+
+@given(st.lists(st.tuples(st.lists(st.lists(bars, min_size=1, max_size=3), min_size=1, max_size=4),
+                          st.lists(bars, min_size=1, max_size=3)), min_size=1, max_size=3))
+def test_diagrams_read_back_bit_for_bit(regions_bars):
+    # each region: windows' diagrams and a diagram of its own, written after the windows as run_job does
+    regions = [{"events": i, "window": 0.5 * i, "windows": [{"t0": 0.0, "diagram": _diagram(d)} for d in windows],
+                "diagram": _diagram(own)} for i, (windows, own) in enumerate(regions_bars)]
     back = decode_regions(encode_regions(regions))
-    assert [r["events"] for r in back] == [0, 1] and back[1]["window"] == 0.5
+    assert [r["events"] for r in back] == list(range(len(regions))) and back[-1]["window"] == 0.5 * (len(regions) - 1)
+
+    def same(got, want):
+        assert len(got.pairs) == len(want.pairs)
+        for g, w in zip(got.pairs, want.pairs):
+            assert g.tobytes() == np.ascontiguousarray(w, dtype=float).tobytes()
     for region, original in zip(back, regions):
+        same(region["diagram"], original["diagram"])
         for w, o in zip(region["windows"], original["windows"]):
-            assert len(w["diagram"].pairs) == len(o["diagram"].pairs)
-            for got, want in zip(w["diagram"].pairs, o["diagram"].pairs):
-                assert got.tobytes() == np.ascontiguousarray(want, dtype=float).tobytes()
+            same(w["diagram"], o["diagram"])
 
 
 def test_rows_keep_the_diagrams_asked_for_and_a_store_that_keeps_less_is_rerun(tmp_path):
@@ -103,18 +110,44 @@ def test_rows_keep_the_diagrams_asked_for_and_a_store_that_keeps_less_is_rerun(t
     assert row["diagrams_kept"] == "windows" and plain(row) == plain(rows["windows"])
 
 
-def test_a_reader_and_the_writer_take_turns(tmp_path):
+def test_a_reader_in_another_process_and_the_writer_take_turns(tmp_path):
     store_path = tmp_path / "s.duckdb"
     store = ResultStore(store_path)
     rows = [run_job(job) for job in cheap_jobs("turns", 3)]
     assert store.write(rows[:1])
-    reading = iter_jobs(store_path, batch_rows=1)
-    first = next(reading)  # the file is open for reading until the generator ends
-    assert not store.write(rows[1:], wait=0.2)  # busy: nothing written, the caller keeps the rows
-    assert [r["key"] for r in reading] == [] and first["key"] == rows[0]["key"]
+    holder = subprocess.Popen([sys.executable, "-c", "import duckdb, sys; db = duckdb.connect(sys.argv[1], "
+                               "read_only=True); print('open', flush=True); sys.stdin.read()", str(store_path)],
+                              stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline() == "open\n"
+        assert not store.write(rows[1:], wait=0.3)  # held: nothing written, the caller keeps the rows
+        assert len(store_status(store_path).failures) == 0  # readers share the file
+    finally:
+        holder.communicate("", timeout=30)
     assert store.write(rows[1:])
-    assert [r["key"] for r in iter_jobs(store_path, batch_rows=2)] == sorted(r["key"] for r in rows)
+    # iter_jobs opens the file for each batch: a writer gets its turn between them
+    reading = iter_jobs(store_path, batch_rows=1)
+    first = next(reading)
+    assert store.write([dict(rows[0], t_total=-1.0)])
+    assert [first["key"], *(r["key"] for r in reading)] == sorted(r["key"] for r in rows)
     assert [r["key"] for r in iter_jobs(store_path, keys=[rows[2]["key"]], columns=("key",))] == [rows[2]["key"]]
+
+
+def test_a_failed_row_never_replaces_a_good_one_and_rows_go_aside_when_the_store_refuses(tmp_path):
+    import pyarrow.parquet as pq
+
+    from swarmtopo.experiments.sweep import failed_row
+
+    job = cheap_jobs("replace", 1)[0]
+    good = run_job(job)
+    assert good["status"] == "ok"
+    store = ResultStore(tmp_path / "s.duckdb")
+    assert store.write([failed_row(job, "timeout", "ran past")]) and store.write([good])  # good replaces failed
+    assert store.write([failed_row(job, "crashed", "killed")])  # ... but not the other way round
+    (row,) = read_jobs(tmp_path / "s.duckdb")
+    assert row["status"] == "ok" and plain(row) == plain(good)
+    aside = store.save_aside([good])
+    assert aside.parent == tmp_path and pq.read_table(aside).column("key").to_pylist() == [good["key"]]
 
 
 def test_failures_group_by_kind_and_message_up_to_numbers():
@@ -169,7 +202,7 @@ def test_a_job_that_kills_its_workers_is_a_crashed_row(tmp_path, importable_test
         summary = run_sweep(jobs, tmp_path / "s.duckdb", workers=1, runner=sweep_faults.worker_killer)
     assert summary.failed == {"crashed": 1}
     (row,) = read_jobs(tmp_path / "s.duckdb")
-    assert row["status"] == "crashed" and row["error"].startswith("its workers died running it (KilledWorker")
+    assert row["status"] == "crashed" and row["error"].startswith("its workers died twice running it alone (KilledWorker")
 
 
 def test_jobs_per_task_grow_as_jobs_prove_cheap():

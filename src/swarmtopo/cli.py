@@ -541,8 +541,10 @@ def sweep(
                       markup=False, highlight=False, soft_wrap=True)
         raise typer.Exit(130) from None
     except SchedulerLost as exc:
-        command = ["swarmtopo", "sweep", str(config), "--store", str(store), "--scheduler", str(scheduler)]
-        command += (["--job-timeout", f"{job_timeout:g}"] if job_timeout is not None else [])
+        command = ["swarmtopo", "sweep", str(config), "--store", str(store)]
+        command += ["--scheduler", scheduler] if scheduler is not None else []
+        command += ["--workers", str(workers)] if workers is not None else []
+        command += ["--job-timeout", f"{job_timeout:g}"] if job_timeout is not None else []
         command += ["--retry-failed"] if retry_failed else []
         err.print(f"error: {exc}; once the scheduler is back, resume with: {shlex.join(command)}",
                   markup=False, highlight=False, soft_wrap=True)

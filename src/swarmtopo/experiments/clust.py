@@ -61,7 +61,7 @@ def reproduce_clust(out: Path, *, runs: int | None = None, progress: Callable[[i
     sweeps = clust_sweeps(runs)
     summary = run_sweep([job for s in sweeps.values() for job in s.jobs], store,
                         workers=workers, scheduler=scheduler, progress=progress)
-    by_key = {row["key"]: row for row in read_jobs(store)}
+    by_key = {row["key"]: row for row in read_jobs(store, keys=[job.key for s in sweeps.values() for job in s.jobs])}
     rows = {name: [by_key[key] for key in sorted(job.key for job in s.jobs)] for name, s in sweeps.items()}
     train = examples_from_rows(rows["train"])
 

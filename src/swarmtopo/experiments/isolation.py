@@ -8,9 +8,10 @@ and reports what happened.  The child is a plain ``python -m`` subprocess (Dask 
 are daemonic processes, which ``multiprocessing`` may not fork from), started on first
 use, warmed up before any timed call, and started again after it died or was killed.
 
-Protocol: length-prefixed pickles on the child's stdin and on a duplicate of its
-stdout (its ``sys.stdout`` goes to stderr, so a library's prints cannot garble a reply).
-The child exits when its stdin closes or its parent dies.
+Protocol: length-prefixed pickles on duplicates of the child's stdin and stdout (its
+stdout then goes to stderr and its stdin reads an empty file, so a call's prints or
+reads cannot garble the protocol).  The child exits when its requests end or its
+parent dies; every BLAS, OpenMP and numba pool in it has one thread.
 """
 
 from __future__ import annotations
@@ -67,16 +68,19 @@ class JobProcess:
 
     def _start(self) -> tuple[str, str] | None:
         """Start the child and warm it up; None if it is ready, else the failure."""
-        env = {**os.environ, "NUMBA_NUM_THREADS": "1"}  # one core per job, whatever the worker's setting
-        self._proc = subprocess.Popen([sys.executable, "-m", __name__], stdin=subprocess.PIPE,
+        # one core per job, whatever the worker's settings: numba's threads and any BLAS / OpenMP pool
+        env = {**os.environ, **dict.fromkeys(ONE_THREAD, "1")}
+        self._proc = subprocess.Popen([sys.executable, "-m", __name__, str(os.getpid())], stdin=subprocess.PIPE,
                                       stdout=subprocess.PIPE, env=env)
         if self._warm_up is None:
             return None
-        outcome = self._exchange((_call, self._warm_up), STARTUP_SECONDS)
-        if outcome[0] == "ok":
+        kind, message = self._exchange((_call, self._warm_up), STARTUP_SECONDS)
+        if kind == "ok":
             return None
         self.close()
-        return "crashed", f"the job process could not start ({outcome[1]})"
+        if kind == "timeout":
+            message = f"its warm-up took more than {STARTUP_SECONDS:g} s"
+        return "crashed", f"the job process could not start ({message})"
 
     def _exchange(self, message, timeout: float | None) -> tuple[str, Any]:
         proc = self._proc
@@ -87,7 +91,11 @@ class JobProcess:
             self.close()
             return "timeout", None
         except (EOFError, OSError):  # the child died (a broken pipe, or end of file)
-            code = proc.wait()
+            try:
+                code = proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:  # it closed its pipes but lives on
+                proc.kill()
+                code = proc.wait()
             self._proc = None
             return "crashed", _death(code)
         return pickle.loads(reply)
@@ -113,11 +121,13 @@ def _send(stream, payload: bytes) -> None:
 def _receive(stream, deadline: float | None) -> bytes:
     """One length-prefixed message; TimeoutError past ``deadline``, EOFError if the writer died."""
     fd = stream.fileno()
+    readable = select.poll()
+    readable.register(fd, select.POLLIN)
     chunks, need, header = [], 8, None
     while need:
         if deadline is not None:
             left = deadline - time.monotonic()
-            if left <= 0 or not select.select([fd], [], [], left)[0]:
+            if left <= 0 or not readable.poll(1000 * left):
                 raise TimeoutError
         chunk = os.read(fd, min(need, 1 << 20))
         if not chunk:
@@ -135,6 +145,21 @@ def _call(fn):
     return fn()
 
 
+ONE_THREAD = ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+"""Environment variables set to 1 in the job process."""
+
+
+def _die_with_parent() -> None:
+    """Be killed when the thread that started this process ends, with its worker (Linux:
+    PR_SET_PDEATHSIG), even in a call that holds the GIL; elsewhere :func:`_watch_parent`."""
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)
+    except (OSError, AttributeError):
+        pass
+
+
 def _watch_parent(parent: int) -> None:
     """Exit as soon as the parent is gone (a hung call would otherwise outlive its worker)."""
     while os.getppid() == parent:
@@ -142,14 +167,22 @@ def _watch_parent(parent: int) -> None:
     os._exit(1)
 
 
-def _serve() -> None:
+def _serve(parent: int) -> None:
     """The child's loop: read (fn, arg), reply ("ok", fn(arg)) or ("error", one line)."""
+    _die_with_parent()
+    if os.getppid() != parent:  # the parent died before this process could follow it
+        return
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the sweep's client alone handles Ctrl-C
+    # the protocol's pipes on descriptors of their own: a call's prints go to stderr, and
+    # a call that reads stdin (or a program it starts) reads an empty file
     replies = os.fdopen(os.dup(1), "wb")
+    requests = os.fdopen(os.dup(0), "rb")
     os.dup2(2, 1)
+    null = os.open(os.devnull, os.O_RDONLY)
+    os.dup2(null, 0)
+    os.close(null)
     sys.stdout = sys.stderr
-    threading.Thread(target=_watch_parent, args=(os.getppid(),), daemon=True).start()
-    requests = sys.stdin.buffer
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
     while True:
         try:
             (size,) = struct.unpack("<Q", _read_exactly(requests, 8))
@@ -160,7 +193,7 @@ def _serve() -> None:
             fn, arg = pickle.loads(request)
             outcome = ("ok", fn(arg))
             payload = pickle.dumps(outcome, protocol=pickle.HIGHEST_PROTOCOL)
-        except Exception as exc:  # noqa: BLE001 - any failure of the call is its row's message
+        except BaseException as exc:  # noqa: BLE001 - any failure of the call (SystemExit too) is its message
             payload = pickle.dumps(("error", one_line(exc)), protocol=pickle.HIGHEST_PROTOCOL)
         _send(replies, payload)
 
@@ -179,4 +212,4 @@ def one_line(exc: BaseException) -> str:
 
 
 if __name__ == "__main__":
-    _serve()
+    _serve(int(sys.argv[1]))

@@ -112,13 +112,13 @@ def encode_regions(regions: list[dict[str, Any]]) -> bytes:
         if isinstance(item, Diagram):
             arrays.extend(np.asarray(p, dtype="<f8").reshape(-1, 2) for p in item.pairs)
             return {"bars": [len(p) for p in item.pairs]}
-        if isinstance(item, dict):
-            return {k: strip(v) for k, v in item.items()}
+        if isinstance(item, dict):  # in key order: the order the header is written and read back in
+            return {k: strip(item[k]) for k in sorted(item)}
         if isinstance(item, list):
             return [strip(v) for v in item]
         return item
 
-    header = json.dumps(strip(regions), sort_keys=True, separators=(",", ":"), allow_nan=False).encode()
+    header = json.dumps(strip(regions), separators=(",", ":"), allow_nan=False).encode()
     body = struct.pack("<I", len(header)) + header + b"".join(a.tobytes() for a in arrays)
     return _MAGIC + struct.pack("<Q", len(body)) + pa.compress(body, codec="zstd", asbytes=True)
 
@@ -158,7 +158,7 @@ def _is_lock_conflict(exc: Exception) -> bool:
     """Whether DuckDB refused the file because it is open elsewhere: by another process
     (a lock) or, in this process, by a connection of the other mode."""
     text = str(exc).lower()
-    return "lock" in text or "different configuration" in text
+    return "could not set lock" in text or "conflicting lock" in text or "different configuration" in text
 
 
 def _connect(path: Path, *, read_only: bool, wait: float):
@@ -215,8 +215,12 @@ class ResultStore:
                            "workers INTEGER, started_at TIMESTAMP, updated_at TIMESTAMP, outcome TEXT)")
                 db.execute("COMMIT")
             _check_schema(db, self.path)
-        self._insert = (f"INSERT OR REPLACE INTO jobs ({', '.join(_QUOTED)}) "
-                        f"SELECT {', '.join(_QUOTED)} FROM batch")
+        # a retried job's new row replaces the old one, but a failed row never replaces a
+        # good one (a job rerun to keep more diagrams that then crashed keeps its result)
+        updates = ", ".join(f"{q} = excluded.{q}" for q in _QUOTED if q != '"key"')
+        self._insert = (f"INSERT INTO jobs ({', '.join(_QUOTED)}) SELECT {', '.join(_QUOTED)} FROM batch "
+                        f"ON CONFLICT (key) DO UPDATE SET {updates} "
+                        "WHERE excluded.status = 'ok' OR jobs.status <> 'ok'")
 
     def add_to_sweep(self, sweep: str, keys: Iterable[str]) -> None:
         """Record that ``sweep`` asks for the jobs ``keys`` (one transaction)."""
@@ -230,7 +234,8 @@ class ResultStore:
             return {k: (s, kept) for k, s, kept in db.execute("SELECT key, status, diagrams_kept FROM jobs").fetchall()}
 
     def write(self, rows: Sequence[dict[str, Any]], *, wait: float = 0.0) -> bool:
-        """Write rows in one transaction, replacing rows of the same keys (a retried job).
+        """Write rows in one transaction, replacing failed rows of the same keys (a retried
+        job) and ok rows by ok rows (a job rerun to keep more diagrams).
 
         Returns False, writing nothing, if another process still holds the file after
         ``wait`` s (the caller keeps the rows and tries again).  Each row must have
@@ -239,18 +244,27 @@ class ResultStore:
         """
         if not rows:
             return True
-        table = _arrow_rows(rows)
+        if len({row["key"] for row in rows}) < len(rows):
+            raise ValueError("a batch holds two rows of the same job")
         db = _connect(self.path, read_only=False, wait=wait)
         if db is None:
             return False
         try:
-            db.register("batch", table)
+            db.register("batch", _arrow_rows(rows))
             db.execute("BEGIN")
             db.execute(self._insert)
             db.execute("COMMIT")
         finally:
             db.close()
         return True
+
+    def save_aside(self, rows: Sequence[dict[str, Any]]) -> Path:
+        """Write rows the store could not take to a Parquet file beside it; its path."""
+        import pyarrow.parquet as pq
+
+        aside = self.path.with_name(f"{self.path.name}.unsaved-{os.getpid()}-{time.time_ns()}.parquet")
+        pq.write_table(_arrow_rows(rows), aside)
+        return aside
 
     def start_run(self, scheduler: str | None, workers: int) -> str:
         """Record a new run of a sweep on this store; its id."""
@@ -330,41 +344,44 @@ def iter_jobs(path, *, sweep: str | None = None, keys: Iterable[str] | None = No
         :class:`Diagram` objects), ``lengths_h1`` a list of floats, ``finished_at`` a naive
         UTC datetime.
 
-    The file is open (read only) while the generator runs; a sweep writing to it waits.
+    The file is opened (read only) for each batch, so a sweep writing to it is never held
+    up for long; rows a sweep writes after the keys were selected are not yielded.
     """
     path = Path(path)
     if not path.exists():
         raise SwarmtopoError(f"{path}: no such result store")
+    where, params = [], []
+    if sweep is not None:
+        where.append("key IN (SELECT key FROM sweep_jobs WHERE sweep = ?)")
+        params.append(sweep)
+    if keys is not None:
+        where.append("key IN (SELECT unnest(?::TEXT[]))")
+        params.append(list(keys))
+    if status is not None:
+        where.append("status = ?")
+        params.append(status)
+    condition = f" WHERE {' AND '.join(where)}" if where else ""
     with _opened(path, read_only=True) as db:
         _check_schema(db, path, columns)
-        where, params = [], []
-        if sweep is not None:
-            where.append("key IN (SELECT key FROM sweep_jobs WHERE sweep = ?)")
-            params.append(sweep)
-        if keys is not None:
-            where.append("key IN (SELECT unnest(?::TEXT[]))")
-            params.append(list(keys))
-        if status is not None:
-            where.append("status = ?")
-            params.append(status)
-        condition = f" WHERE {' AND '.join(where)}" if where else ""
-        # the keys first, sorted; then the rows a batch of keys at a time: sorting whole
-        # rows would hold every diagram in memory at once
         selected_keys = [k for (k,) in db.execute(f"SELECT key FROM jobs{condition} ORDER BY key", params).fetchall()]
-        selected = "*" if columns is None else ", ".join(f'"{name}"' for name in columns)
-        for start in range(0, len(selected_keys), batch_rows):
-            chunk = selected_keys[start:start + batch_rows]
+    # then the rows a batch of keys at a time, the file opened for each batch: a sweep
+    # writing to the store gets its turns between them, and sorting whole rows would
+    # hold every diagram in memory at once
+    selected = "*" if columns is None else ", ".join(f'"{name}"' for name in columns)
+    for start in range(0, len(selected_keys), batch_rows):
+        with _opened(path, read_only=True) as db:
             cursor = db.execute(f"SELECT {selected} FROM jobs WHERE key IN (SELECT unnest(?::TEXT[])) ORDER BY key",
-                                [chunk])
+                                [selected_keys[start:start + batch_rows]])
             names = [d[0] for d in cursor.description]
-            for values in cursor.fetchall():
-                row = dict(zip(names, values))
-                for name in JSON_COLUMNS:
-                    if row.get(name) is not None:
-                        row[name] = json.loads(row[name])
-                if row.get("diagrams") is not None:
-                    row["diagrams"] = decode_regions(row["diagrams"])
-                yield row
+            batch = cursor.fetchall()
+        for values in batch:
+            row = dict(zip(names, values))
+            for name in JSON_COLUMNS:
+                if row.get(name) is not None:
+                    row[name] = json.loads(row[name])
+            if row.get("diagrams") is not None:
+                row["diagrams"] = decode_regions(row["diagrams"])
+            yield row
 
 
 def read_jobs(path, sweep: str | None = None, columns: Sequence[str] | None = None,
@@ -440,15 +457,10 @@ class StoreStatus:
     failures: list[FailureGroup]
     runs: list[dict[str, Any]] = field(default_factory=list)
 
-    @property
-    def running(self) -> list[dict[str, Any]]:
-        """Runs that have not ended and wrote within the last ``RUN_STALE`` seconds."""
-        now = _utcnow()
-        return [r for r in self.runs if r["outcome"] is None and (now - r["updated_at"]).total_seconds() < RUN_STALE]
-
 
 RUN_STALE = 120.0
-"""A run that has not written for this long without ending is reported as stopped (killed)."""
+"""A run that has not noted it is alive for this long (it does every ``TOUCH_SECONDS`` of
+:mod:`.sweep`) and has not ended is reported as stopped: killed."""
 
 
 def store_status(path) -> StoreStatus:

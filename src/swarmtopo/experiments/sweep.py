@@ -192,11 +192,15 @@ def run_job(job: Job, keep: str = "map") -> dict[str, Any]:
     return row
 
 
-def failed_row(job: Job, status: str, message: str, seconds: float | None = None) -> dict[str, Any]:
+def failed_row(job: Job, status: str, message: str, seconds: float | None = None, *,
+               in_client: bool = False) -> dict[str, Any]:
     """The row of a job that did not finish: ``status`` a failure kind (``FAILURES``),
-    the one-line ``message``, the truth and estimates NULL."""
+    the one-line ``message``, the truth and estimates NULL; its worker this process, or
+    unknown (NULL) for a row the client writes."""
     row = _identity_row(job)
     row.update(status=status, error=message, t_total=seconds)
+    if in_client:
+        row["worker"] = None
     return row
 
 
@@ -225,8 +229,14 @@ def run_isolated(jobs: list[Job], keep: str, timeout: float | None,
     rows = []
     for job in jobs:
         start = time.perf_counter()
-        kind, value = process.call(_call_runner, (runner, job, keep), timeout)
-        rows.append(value if kind == "ok" else failed_row(job, kind, value, time.perf_counter() - start))
+        try:
+            kind, value = process.call(_call_runner, (runner, job, keep), timeout)
+        except Exception as exc:  # noqa: BLE001 - the worker could not hand the job over (no memory to fork, ...)
+            process.close()
+            kind, value = "crashed", f"its worker could not run it ({one_line(exc)})"
+        row = value if kind == "ok" else failed_row(job, kind, value, time.perf_counter() - start)
+        row["worker"] = f"{socket.gethostname()}:{os.getpid()}"  # the Dask worker, not its job process
+        rows.append(row)
     return rows
 
 
@@ -298,6 +308,8 @@ FLUSH_SECONDS = 1.0
 """Most seconds a finished row waits in the client before it is written."""
 FLUSH_ROWS = 500
 """Rows per write at most (a batch is one transaction)."""
+TOUCH_SECONDS = 30.0
+"""How often a run notes in the store that it is alive (``swarmtopo status``)."""
 
 
 def run_sweep(
@@ -383,6 +395,10 @@ def run_sweep(
         try:
             _run_pending(client, pending, batch, say, keep=keep, timeout=job_timeout, runner=runner,
                          address=scheduler or "the local cluster")
+        except BaseException as exc:
+            batch.outcome = ("interrupted" if isinstance(exc, KeyboardInterrupt) else
+                             "scheduler lost" if isinstance(exc, SchedulerLost) else f"failed: {one_line(exc)}")
+            raise
         finally:
             batch.close()
         return SweepSummary(total=len(unique), skipped=len(unique) - len(pending), run=batch.written,
@@ -402,8 +418,9 @@ def _finished(stored: tuple[str, str | None] | None, keep: str, retry_failed: bo
 
 
 class _Batches:
-    """Finished rows on their way to the store: written every ``FLUSH_SECONDS`` or
-    ``FLUSH_ROWS``, kept in memory (and retried) while another process holds the file."""
+    """Finished rows on their way to the store: written every ``FLUSH_SECONDS`` (or at
+    ``FLUSH_ROWS``), kept in memory and tried again while another process holds the
+    file; the run noted alive in the store every ``TOUCH_SECONDS``."""
 
     def __init__(self, store: ResultStore, scheduler: str | None, client):
         self.store, self.client = store, client
@@ -413,39 +430,57 @@ class _Batches:
         self.written = 0
         self.failed: Counter[str] = Counter()
         self.messages: list[tuple[str, str]] = []
-        self.last = time.monotonic()
-        self.outcome = "interrupted"
+        self.last = self.touched = time.monotonic()
+        self.busy = False  # the last write found the file held by another process
+        self.outcome = "finished"
 
     def add(self, row: dict[str, Any]) -> None:
         self.rows.append(row)
         if row["status"] != "ok":
             self.failed[row["status"]] += 1
             self.messages.append((row["status"], row["error"]))
-        if len(self.rows) >= FLUSH_ROWS or time.monotonic() - self.last >= FLUSH_SECONDS:
+        if len(self.rows) >= FLUSH_ROWS and not self.busy:
             self.flush()
 
     @property
     def done(self) -> int:
         return self.written + len(self.rows)
 
+    def tick(self) -> None:
+        """Write the rows if they have waited FLUSH_SECONDS; note the run alive if due."""
+        now = time.monotonic()
+        if self.rows and now - self.last >= FLUSH_SECONDS:
+            self.flush()
+        elif now - self.touched >= TOUCH_SECONDS:
+            self.touch()
+
     def flush(self, wait: float = 0.0) -> None:
         self.last = time.monotonic()
         while self.rows:
             chunk = self.rows[:FLUSH_ROWS]
-            if not self.store.write(chunk, wait=wait):
-                return  # the file is busy: the rows wait for the next flush
+            self.busy = not self.store.write(chunk, wait=wait)
+            if self.busy:
+                return  # the rows wait for the next turn
             del self.rows[:FLUSH_ROWS]
             self.written += len(chunk)
+        if time.monotonic() - self.touched >= TOUCH_SECONDS:
+            self.touch()
+
+    def touch(self, outcome: str | None = None, wait: float = 0.0) -> None:
+        self.touched = time.monotonic()
         self.workers = _worker_count(self.client, self.workers)
-        self.store.touch_run(self.run, self.workers)
+        self.store.touch_run(self.run, self.workers, outcome, wait=wait)
 
     def close(self) -> None:
-        """Write what is left (waiting up to LOCK_WAIT for the file), and how the run ended."""
+        """Write what is left (waiting up to LOCK_WAIT for the file) and how the run ended;
+        rows the file still refuses go to a Parquet file beside it (named in the error)."""
         self.flush(wait=LOCK_WAIT)
         if self.rows:
-            raise SwarmtopoError(f"{self.store.path}: {len(self.rows)} finished row(s) could not be written: "
-                                 f"another process has held the store for {LOCK_WAIT:g} s")
-        self.store.touch_run(self.run, self.workers, self.outcome, wait=LOCK_WAIT)
+            aside = self.store.save_aside(self.rows)
+            raise SwarmtopoError(f"{self.store.path}: another process has held the store for {LOCK_WAIT:g} s; "
+                                 f"{len(self.rows)} finished row(s) are in {aside} instead (a rerun runs those "
+                                 "jobs again)")
+        self.touch(self.outcome, wait=LOCK_WAIT)
 
 
 def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, timeout, runner, address) -> None:
@@ -461,6 +496,7 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
     """
     from concurrent.futures import CancelledError
 
+    from dask.base import tokenize
     from distributed import as_completed
     from distributed.scheduler import KilledWorker
 
@@ -471,6 +507,8 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
     running: dict[str, tuple[Any, list[Job], int | None]] = {}  # task key -> (future, its jobs, deaths)
     seconds: list[float] = []  # the finished jobs' t_total
     finished = as_completed()
+    # task keys name the settings too: another sweep on the same cluster may run the same job otherwise
+    settings = tokenize(keep, timeout, f"{runner.__module__}.{runner.__qualname__}")
 
     def submit() -> None:
         size = _jobs_per_task(seconds)
@@ -483,7 +521,8 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
             tasks.append((task, deaths))
         if tasks:
             futures = client.map(run_isolated, [task for task, _ in tasks],
-                                 key=[f"swarmtopo-jobs-{task[0].key}-{len(task)}-{deaths}" for task, deaths in tasks],
+                                 key=[f"swarmtopo-jobs-{task[0].key}-{len(task)}-{deaths}-{settings}"
+                                      for task, deaths in tasks],
                                  keep=keep, timeout=timeout, runner=runner)
             running.update((future.key, (future, *task)) for future, task in zip(futures, tasks))
             finished.update(futures)
@@ -499,26 +538,25 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
                     if client.status != "running":
                         raise SchedulerLost(address, batch.done, jobs_left, "connection closed")
                     time.sleep(POLL_SECONDS)
-                    if time.monotonic() - batch.last >= FLUSH_SECONDS:
-                        batch.flush()
+                    batch.tick()
                 for future in done:
                     _, task, deaths = running.pop(future.key)
                     try:
                         rows = future.result()
                     except KilledWorker as exc:
-                        future.release()
                         if len(task) > 1:  # which of them? each alone
                             queue.extendleft((job, 0) for job in reversed(task))
                             continue
                         if not deaths:  # alone, once more
                             queue.appendleft((task[0], (deaths or 0) + 1))
                             continue
-                        rows = [failed_row(task[0], "crashed", f"its workers died running it ({one_line(exc)})")]
+                        rows = [failed_row(task[0], "crashed", f"its workers died twice running it alone "
+                                           f"({one_line(exc)})", in_client=True)]
                     except CancelledError:
                         raise SchedulerLost(address, batch.done, jobs_left,
                                             "its tasks were cancelled: scheduler-connection-lost") from None
                     except Exception as exc:  # noqa: BLE001 - a task's own failure is its jobs' rows
-                        rows = [failed_row(job, "error", one_line(exc)) for job in task]
+                        rows = [failed_row(job, "error", one_line(exc), in_client=True) for job in task]
                     future.release()
                     for row in rows:
                         batch.add(row)
@@ -526,12 +564,9 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
                         if row["t_total"] is not None:
                             seconds.append(row["t_total"])
                     say(batch.done, len(pending), sum(batch.failed.values()))
+                batch.tick()
                 if len(running) < window // 2:
                     submit()
-        batch.outcome = "finished"
-    except SchedulerLost:
-        batch.outcome = "scheduler lost"
-        raise
     finally:
         if running and client.status == "running":
             client.cancel([future for future, _ in running.values()])

@@ -66,8 +66,9 @@ def examples_from_rows(rows: Sequence[dict[str, Any]]) -> Examples:
     diagrams, truth, beta0 = [], [], []
     excluded = {"no map (too little data)": 0, "disconnected arena": 0}
     for row in rows:
-        if row["error"] is not None:
-            excluded["no map (too little data)"] += 1
+        if row["error"] is not None:  # a job that crashed or timed out is named apart
+            reason = "too little data" if row.get("status", "error") == "error" else row["status"]
+            excluded[f"no map ({reason})"] = excluded.get(f"no map ({reason})", 0) + 1
             continue
         beta0.append(row["est_betti0"] == row["true_betti0"])
         if row["true_betti0"] != 1:
