@@ -430,21 +430,24 @@ def run_benchmark(store, *, quick: bool = False, scheduler: str | None = None, w
                         keep="windows")
     classifiers = {name: load_classifier(PIPELINES[name]["classifier"]) for name in PIPELINES}
     paper_theta = published_paper_classifier()
-    results: dict[str, list] = {name: [] for name in (*PIPELINES, "paper-theta")}
-    planning_records: list = []
+    found: dict[str, list] = {name: [] for name in (*PIPELINES, "paper-theta", "planning")}  # (key, record)
     planning_keys = {job.key for job in planning}
     maps = 0
-    # one row in memory at a time (every window's diagrams), in key order as each list was
+    # the rows stream (every window's diagrams: one chunk in memory at a time); each list
+    # of records is then sorted by key, whatever order the jobs finished in
     for row in iter_jobs(store, keys=[job.key for job in jobs + planning]):
         if row["key"] in planning_keys:
-            planning_records += outcomes([row], classifiers["default"], cells=planning_cells)
+            found["planning"] += [(row["key"], r) for r in outcomes([row], classifiers["default"], cells=planning_cells)]
             continue
         maps += 1
         name = _pipeline_of(row["config"])
         if name is not None:
-            results[name] += outcomes([row], classifiers[name])
+            found[name] += [(row["key"], r) for r in outcomes([row], classifiers[name])]
         if name == "paper":
-            results["paper-theta"] += outcomes([row], paper_theta)
+            found["paper-theta"] += [(row["key"], r) for r in outcomes([row], paper_theta)]
+    by_key = {name: [r for _, r in sorted(pairs, key=lambda pair: pair[0])] for name, pairs in found.items()}
+    planning_records = by_key.pop("planning")
+    results = by_key
     return {
         "suite": SUITE, "cases_per_cell": per_cell, "maps": maps,
         "seconds": summary.seconds, "jobs_run": summary.run, "workers": summary.workers,

@@ -35,7 +35,7 @@ Writing and reading.  The sweep's client holds the file only while it writes a b
 of rows (one transaction: after a crash a batch is there whole or not at all), so
 another process can read the store while a sweep runs (``swarmtopo status``,
 :func:`iter_jobs`); either side waits its turn when the other holds the file.
-:func:`iter_jobs` streams rows a batch at a time and reads only the columns asked for.
+:func:`iter_jobs` streams rows a chunk at a time and reads only the columns asked for.
 """
 
 from __future__ import annotations
@@ -318,9 +318,8 @@ def _arrow_types() -> dict:
 # -- reading ------------------------------------------------------------------------------
 def iter_jobs(path, *, sweep: str | None = None, keys: Iterable[str] | None = None,
               columns: Sequence[str] | None = None, status: str | None = None,
-              batch_rows: int = 128) -> Iterator[dict[str, Any]]:
-    """Stream the rows of a result store as dicts, sorted by key, ``batch_rows`` at a time
-    (only the selected keys and one batch of rows are in memory at once).
+              chunk_rows: int = 2048) -> Iterator[dict[str, Any]]:
+    """Stream the rows of a result store as dicts, in the order they were written.
 
     Parameters
     ----------
@@ -331,10 +330,13 @@ def iter_jobs(path, *, sweep: str | None = None, keys: Iterable[str] | None = No
     keys
         Only the rows of these job keys.
     columns
-        Only these columns (``key`` among them); a store written by another swarmtopo
-        version is read too if it has them.  None = every column.
+        Only these columns; a store written by another swarmtopo version is read too if it
+        has them.  None = every column.
     status
         Only rows of this status (``"ok"`` or a failure kind).
+    chunk_rows
+        Rows read at a time (DuckDB reads 2,048 at a time anyway): the most held in
+        memory, with their compressed diagrams, at once.
 
     Yields
     ------
@@ -344,8 +346,12 @@ def iter_jobs(path, *, sweep: str | None = None, keys: Iterable[str] | None = No
         :class:`Diagram` objects), ``lengths_h1`` a list of floats, ``finished_at`` a naive
         UTC datetime.
 
-    The file is opened (read only) for each batch, so a sweep writing to it is never held
-    up for long; rows a sweep writes after the keys were selected are not yielded.
+    The file is opened (read only) for each chunk, so a sweep writing to it gets its turns
+    between them; rows written after the first chunk was read are not yielded, and a row
+    a sweep replaces meanwhile (``--retry-failed``, more diagrams kept) may be missed:
+    read a store whose sweep is running for a look, and one whose sweep has ended for
+    results.  The order is the store's, which depends on the order jobs finished: sort
+    what you keep (:func:`read_jobs` sorts by key).
     """
     path = Path(path)
     if not path.exists():
@@ -360,22 +366,25 @@ def iter_jobs(path, *, sweep: str | None = None, keys: Iterable[str] | None = No
     if status is not None:
         where.append("status = ?")
         params.append(status)
-    condition = f" WHERE {' AND '.join(where)}" if where else ""
     with _opened(path, read_only=True) as db:
         _check_schema(db, path, columns)
-        selected_keys = [k for (k,) in db.execute(f"SELECT key FROM jobs{condition} ORDER BY key", params).fetchall()]
-    # then the rows a batch of keys at a time, the file opened for each batch: a sweep
-    # writing to the store gets its turns between them, and sorting whole rows would
-    # hold every diagram in memory at once
+        (last,) = db.execute("SELECT max(rowid) FROM jobs").fetchone()
     selected = "*" if columns is None else ", ".join(f'"{name}"' for name in columns)
-    for start in range(0, len(selected_keys), batch_rows):
+    # a range of row ids at a time, in storage order: a range reads only its own part of
+    # the file, where sorting rows (or fetching them by key) reads every diagram each time
+    seen: set[str] = set()  # a row moved by a replacement between chunks is yielded once
+    for start in range(0, -1 if last is None else last + 1, chunk_rows):
         with _opened(path, read_only=True) as db:
-            cursor = db.execute(f"SELECT {selected} FROM jobs WHERE key IN (SELECT unnest(?::TEXT[])) ORDER BY key",
-                                [selected_keys[start:start + batch_rows]])
+            cursor = db.execute(f"SELECT {selected} FROM jobs WHERE rowid >= ? AND rowid < ?"
+                                + "".join(f" AND {w}" for w in where), [start, start + chunk_rows, *params])
             names = [d[0] for d in cursor.description]
-            batch = cursor.fetchall()
-        for values in batch:
+            chunk = cursor.fetchall()
+        for values in chunk:
             row = dict(zip(names, values))
+            if "key" in row:
+                if row["key"] in seen:
+                    continue
+                seen.add(row["key"])
             for name in JSON_COLUMNS:
                 if row.get(name) is not None:
                     row[name] = json.loads(row[name])
@@ -386,8 +395,11 @@ def iter_jobs(path, *, sweep: str | None = None, keys: Iterable[str] | None = No
 
 def read_jobs(path, sweep: str | None = None, columns: Sequence[str] | None = None,
               keys: Iterable[str] | None = None) -> list[dict[str, Any]]:
-    """Every row :func:`iter_jobs` yields, as a list (for small stores and selections)."""
-    return list(iter_jobs(path, sweep=sweep, columns=columns, keys=keys))
+    """Every row :func:`iter_jobs` yields, as a list sorted by key (``key`` must be among
+    ``columns``): for small stores and selections."""
+    if columns is not None and "key" not in columns:
+        raise ValueError("read_jobs sorts by key: give it among the columns")
+    return sorted(iter_jobs(path, sweep=sweep, columns=columns, keys=keys), key=lambda row: row["key"])
 
 
 def job_rows(path, jobs, columns: Sequence[str] | None = None) -> list[dict[str, Any]]:

@@ -490,9 +490,10 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
     A task runs one job at first, then as many as take about ``TASK_SECONDS`` at the
     median job time seen so far (at most ``MAX_JOBS_PER_TASK``): cheap jobs do not pay
     Dask's per-task cost each.  A task whose workers died (Dask's KilledWorker) is split
-    into its jobs, each run alone, and a job whose workers died when it ran alone is run
-    alone once more: a job that merely shared a dying worker with the culprit finishes,
-    and only the job that kills its workers again becomes a "crashed" row.
+    into its jobs, each run as a task of its own; a job whose workers died again is a
+    suspect, and suspects run one at a time with nothing else on the cluster, so only a
+    job that kills its workers when it runs alone becomes a "crashed" row (a job that
+    merely shared a dying worker with the culprit finishes).
     """
     from concurrent.futures import CancelledError
 
@@ -500,8 +501,10 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
     from distributed import as_completed
     from distributed.scheduler import KilledWorker
 
-    # (job, None) may share a task; (job, n) runs alone, its workers having died n times when it did
+    # (job, None) may share a task; (job, 0) runs in a task of its own, its workers having died
+    # in a task of several; suspects (their workers died in a task of their own) run alone
     queue: deque[tuple[Job, int | None]] = deque((job, None) for job in pending)
+    suspects: deque[Job] = deque()
     jobs_left = len(pending)  # jobs without a row yet
     window = max(IN_FLIGHT, 4 * sum(client.nthreads().values()))  # tasks in flight at most
     running: dict[str, tuple[Any, list[Job], int | None]] = {}  # task key -> (future, its jobs, deaths)
@@ -511,6 +514,16 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
     settings = tokenize(keep, timeout, f"{runner.__module__}.{runner.__qualname__}")
 
     def submit() -> None:
+        if any(deaths == 1 for _, _, deaths in running.values()):
+            return  # a suspect runs: nothing beside it
+        if suspects:
+            if not running:
+                tasks = [([suspects.popleft()], 1)]
+                futures = client.map(run_isolated, [tasks[0][0]], key=[_task_key(tasks[0], settings)],
+                                     keep=keep, timeout=timeout, runner=runner)
+                running[futures[0].key] = (futures[0], *tasks[0])
+                finished.update(futures)
+            return
         size = _jobs_per_task(seconds)
         tasks = []
         while queue and len(running) + len(tasks) < window:
@@ -520,9 +533,7 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
                 task.append(queue.popleft()[0])
             tasks.append((task, deaths))
         if tasks:
-            futures = client.map(run_isolated, [task for task, _ in tasks],
-                                 key=[f"swarmtopo-jobs-{task[0].key}-{len(task)}-{deaths}-{settings}"
-                                      for task, deaths in tasks],
+            futures = client.map(run_isolated, [task for task, _ in tasks], key=[_task_key(t, settings) for t in tasks],
                                  keep=keep, timeout=timeout, runner=runner)
             running.update((future.key, (future, *task)) for future, task in zip(futures, tasks))
             finished.update(futures)
@@ -530,7 +541,7 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
     submit()
     try:
         with deferred_interrupt() as interrupted:
-            while running:
+            while running or suspects or queue:
                 if interrupted():
                     raise KeyboardInterrupt
                 done = finished.next_batch(block=False)
@@ -544,14 +555,15 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
                     try:
                         rows = future.result()
                     except KilledWorker as exc:
-                        if len(task) > 1:  # which of them? each alone
+                        future.release()
+                        if len(task) > 1:  # which of them? each in a task of its own
                             queue.extendleft((job, 0) for job in reversed(task))
                             continue
-                        if not deaths:  # alone, once more
-                            queue.appendleft((task[0], (deaths or 0) + 1))
+                        if deaths != 1:  # a suspect: it will run alone on the cluster
+                            suspects.append(task[0])
                             continue
-                        rows = [failed_row(task[0], "crashed", f"its workers died twice running it alone "
-                                           f"({one_line(exc)})", in_client=True)]
+                        rows = [failed_row(task[0], "crashed", "its workers died running it alone on the "
+                                           f"cluster ({one_line(exc)})", in_client=True)]
                     except CancelledError:
                         raise SchedulerLost(address, batch.done, jobs_left,
                                             "its tasks were cancelled: scheduler-connection-lost") from None
@@ -565,11 +577,17 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
                             seconds.append(row["t_total"])
                     say(batch.done, len(pending), sum(batch.failed.values()))
                 batch.tick()
-                if len(running) < window // 2:
+                if len(running) < window // 2 or suspects:
                     submit()
     finally:
         if running and client.status == "running":
-            client.cancel([future for future, _ in running.values()])
+            client.cancel([future for future, *_ in running.values()])
+
+
+def _task_key(task: tuple[list[Job], int | None], settings: str) -> str:
+    """Dask key of a task: its first job, its size, how often its workers died, the settings."""
+    jobs, deaths = task
+    return f"swarmtopo-jobs-{jobs[0].key}-{len(jobs)}-{deaths}-{settings}"
 
 
 IN_FLIGHT = 64
