@@ -14,9 +14,10 @@
    transaction per row on a held connection with the diagrams as JSON text (what the
    store did before; the baseline) and in batches of ``FLUSH_ROWS`` with the BLOB
    (``ResultStore.write``): rows per second and the ratio.
-3. Reading: the level-"windows" store streamed back with ``iter_jobs`` (every column,
-   every diagram decoded): rows per second and the peak memory above the start, against
-   the size of all its decoded diagrams.
+3. Reading: a level-"windows" store of ``--stream-rows`` rows (copies of part 1's, three
+   of DuckDB's 2,048-row vectors by default) streamed back with ``iter_jobs`` (every
+   column, every diagram decoded): rows per second and the peak memory above the start,
+   against the size of all its decoded diagrams.
 4. ``--jobs N`` (default 100,000; 0 skips it), in a fresh process: a sweep of N cheap
    jobs (1 agent for 1 s: a real simulate-and-map job that stops at "too little data")
    on the local cluster (``--workers``, default 2): wall time, jobs per minute, the peak
@@ -118,6 +119,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--realistic", type=int, default=24, help="realistic jobs run (default 24)")
     parser.add_argument("--copies", type=int, default=40, help="copies of each row written in part 2 (default 20)")
+    parser.add_argument("--stream-rows", type=int, default=6144, help="rows of the store streamed in part 3")
     parser.add_argument("--jobs", type=int, default=SCALE, help="cheap jobs of the end-to-end sweep (0: skip)")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--sweep-only", action="store_true", help=argparse.SUPPRESS)  # part 4 in a fresh process
@@ -165,7 +167,15 @@ def main() -> None:
               f"{len(batch) / baseline:7.0f} rows/s; batches of {FLUSH_ROWS}, BLOB {len(batch) / batched:7.0f} rows/s "
               f"({baseline / batched:.1f}x)")
 
-        path = Path(tmp) / "windows.duckdb"
+        # a store of several DuckDB vectors (2,048 rows each) of level "windows"
+        path = Path(tmp) / "stream.duckdb"
+        store = ResultStore(path)
+        n_copies = -(-args.stream_rows // len(rows))
+        for i in range(n_copies):  # values scaled apart, as in part 1
+            assert store.write([{**row, "key": f"{row['key']}-{i}",
+                                 "diagrams": encode_regions(_scaled(region, 1.0 + 1e-9 * i))}
+                                for row, region in zip(rows, regions)])
+
         def stream():
             return sum(p.nbytes for row in iter_jobs(path) for region in row["diagrams"]
                        for w in region["windows"] for p in w["diagram"].pairs), row_count(path)
