@@ -318,7 +318,7 @@ def _arrow_types() -> dict:
 # -- reading ------------------------------------------------------------------------------
 def iter_jobs(path, *, sweep: str | None = None, keys: Iterable[str] | None = None,
               columns: Sequence[str] | None = None, status: str | None = None,
-              chunk_rows: int = 2048) -> Iterator[dict[str, Any]]:
+              chunk_rows: int = 512) -> Iterator[dict[str, Any]]:
     """Stream the rows of a result store as dicts, in the order they were written.
 
     Parameters
@@ -335,8 +335,8 @@ def iter_jobs(path, *, sweep: str | None = None, keys: Iterable[str] | None = No
     status
         Only rows of this status (``"ok"`` or a failure kind).
     chunk_rows
-        Rows read at a time (DuckDB reads 2,048 at a time anyway): the most held in
-        memory, with their compressed diagrams, at once.
+        Rows read at a time: with DuckDB's own vector of 2,048 rows, what bounds the
+        memory a read takes, whatever the store's size.
 
     Yields
     ------
@@ -379,7 +379,9 @@ def iter_jobs(path, *, sweep: str | None = None, keys: Iterable[str] | None = No
                                 + "".join(f" AND {w}" for w in where), [start, start + chunk_rows, *params])
             names = [d[0] for d in cursor.description]
             chunk = cursor.fetchall()
-        for values in chunk:
+        chunk.reverse()
+        while chunk:  # each row freed once yielded: one chunk in memory, not two
+            values = chunk.pop()
             row = dict(zip(names, values))
             if "key" in row:
                 if row["key"] in seen:
