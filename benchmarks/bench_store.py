@@ -174,9 +174,10 @@ def main() -> None:
         for n in (args.stream_rows, 2 * args.stream_rows):
             path = Path(tmp) / f"stream-{n}.duckdb"
             store = ResultStore(path)
-            for i in range(-(-n // len(rows))):
-                assert store.write([{**row, "key": f"{row['key']}-{i}", "diagrams": blob}
-                                    for row, blob in zip(rows, blobs)])
+            level = [{**row, "key": f"{row['key']}-{i}", "diagrams": blob}
+                     for i in range(-(-n // len(rows))) for row, blob in zip(rows, blobs)]
+            for i in range(0, len(level), FLUSH_ROWS):
+                assert store.write(level[i:i + FLUSH_ROWS])
 
             def stream():
                 return sum(p.nbytes for row in iter_jobs(path) for region in row["diagrams"]
