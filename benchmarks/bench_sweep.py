@@ -25,6 +25,7 @@ core): simulate, graph, landmarks, persistence, classify, total.  Last line: the
 from __future__ import annotations
 
 import argparse
+import json
 import statistics
 import tempfile
 import time
@@ -35,6 +36,7 @@ from swarmtopo.experiments.clust import CLUST_ARENA, CLUST_MAP, CLUST_SWARM
 from swarmtopo.experiments.grid import expand_grid
 from swarmtopo.experiments.store import RUN_COLUMNS, read_jobs
 from swarmtopo.experiments.sweep import run_sweep
+from swarmtopo.topology.persistence import Diagram
 
 CLUST_JOBS = 1000
 STAGES = ("t_simulate", "t_graph", "t_landmarks", "t_persistence", "t_classify", "t_total")
@@ -89,7 +91,9 @@ def machine_ceiling(n: int = 3_000_000, repeats: int = 3) -> float:
 
 
 def results(rows):
-    return [{k: v for k, v in row.items() if k not in RUN_COLUMNS} for row in rows]
+    """The rows' result columns as plain data (diagrams as JSON: Diagram objects compare by identity)."""
+    plain = [{k: v for k, v in row.items() if k not in RUN_COLUMNS} for row in rows]
+    return json.loads(json.dumps(plain, default=lambda x: x.to_json() if isinstance(x, Diagram) else str(x)))
 
 
 def main() -> None:
