@@ -61,3 +61,10 @@ def kills_worker_at_15(job, keep):
     if job.salt == "chunk-kill" and job.replicate == 15:
         worker_killer(job, keep)
     return run_job(job, keep)
+
+
+def thread_settings(_):
+    """The thread-count variables the job process runs with."""
+    from swarmtopo.experiments.isolation import ONE_THREAD
+
+    return {name: os.environ.get(name) for name in ONE_THREAD}

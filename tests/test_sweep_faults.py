@@ -50,6 +50,8 @@ def test_a_job_process_reports_results_errors_crashes_and_timeouts_and_lives_on(
     process = JobProcess()
     try:
         assert process.call(sweep_faults.add_one, 41, 10) == ("ok", 42)
+        kind, settings = process.call(sweep_faults.thread_settings, None, 10)  # one core per job, always
+        assert kind == "ok" and set(settings.values()) == {"1"} and "NUMBA_NUM_THREADS" in settings
         assert process.call(sweep_faults.shout, 7, 10) == ("ok", 7)  # a print cannot garble the reply
         assert process.call(sweep_faults.raise_value_error, 3, 10) == ("error", "ValueError: bad value 3")
         kind, message = process.call(sweep_faults.die, None, 10)

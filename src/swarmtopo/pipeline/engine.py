@@ -149,11 +149,19 @@ def dask_engine(workers: int | None = None, scheduler: Any = None) -> Iterator[D
         with connected_client(scheduler) as client:
             yield DaskEngine(client)
         return
-    with LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                      dashboard_address=":0", silence_logs=logging.CRITICAL, env={"NUMBA_NUM_THREADS": "1"},
-                      preload=["swarmtopo._dask_plugin"]) as cluster, Client(cluster) as client:
-        client.register_plugin(OneNumbaThread())
-        yield DaskEngine(client)
+    # the local scheduler runs in this process: after Ctrl-C its shutdown may race a scatter
+    # and asyncio would print "Task exception was never retrieved" with a traceback
+    asyncio_log = logging.getLogger("asyncio")
+    level = asyncio_log.level
+    asyncio_log.setLevel(logging.CRITICAL)
+    try:
+        with LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                          dashboard_address=":0", silence_logs=logging.CRITICAL, env={"NUMBA_NUM_THREADS": "1"},
+                          preload=["swarmtopo._dask_plugin"]) as cluster, Client(cluster) as client:
+            client.register_plugin(OneNumbaThread())
+            yield DaskEngine(client)
+    finally:
+        asyncio_log.setLevel(level)
 
 
 @contextmanager
