@@ -21,7 +21,6 @@ after the finished rows are written.
 
 from __future__ import annotations
 
-import logging
 import os
 import socket
 import tempfile
@@ -29,7 +28,7 @@ import statistics
 import threading
 import time
 from collections import Counter, deque
-from contextlib import ExitStack, contextmanager
+from contextlib import ExitStack
 from dataclasses import dataclass, field, replace
 from datetime import datetime, timezone
 from functools import lru_cache
@@ -43,7 +42,7 @@ from ..io import GROUND_TRUTH_META_KEYS, read_arena, read_log, write_log
 from ..log import EncounterLog
 from ..topology.persistence import snr
 from ..pipeline import MapConfig, map_encounters
-from ..pipeline.engine import POLL_SECONDS, connected_client, deferred_interrupt
+from ..pipeline.engine import POLL_SECONDS, connected_client, deferred_interrupt, local_client
 from ..pipeline.result import software_versions
 from ..viz.summary import window_json
 from ..sim import simulate
@@ -390,7 +389,7 @@ def run_sweep(
         start = time.perf_counter()
         say(0, len(pending), 0)
         if client is None:
-            client = stack.enter_context(_local_client(workers, len(pending)))
+            client = stack.enter_context(local_client(min(workers or os.cpu_count() or 1, len(pending))))
         batch = _Batches(store, scheduler, client)
         try:
             _run_pending(client, pending, batch, say, keep=keep, timeout=job_timeout, runner=runner,
@@ -613,26 +612,6 @@ def _worker_count(client, default: int = 0) -> int:
         return len(client.scheduler_info(n_workers=-1)["workers"]) if client.status == "running" else default
     except Exception:  # noqa: BLE001 - a count for the summary, never a reason to fail
         return default
-
-
-@contextmanager
-def _local_client(workers: int | None, n_jobs: int):
-    """A Client of a new local cluster (one-thread worker processes); closes both."""
-    from distributed import Client, LocalCluster
-
-    n_workers = min(workers or os.cpu_count() or 1, n_jobs)
-    # One core per worker: numba's parallel kernels would otherwise start one thread per
-    # core in every worker (BLAS / OpenMP threads are already 1 under Dask's nanny).  The
-    # scheduler's HTTP server takes any free port (8787 may be another cluster's).  The
-    # workers preload swarmtopo._dask_plugin (its dask_setup: they ignore SIGINT, which
-    # the client alone handles).  Only CRITICAL logs: a job's own exception reaches the
-    # client through its future, and after Ctrl-C a worker may log an ERROR with a
-    # traceback while the cluster it belongs to shuts down.
-    with LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=":0",
-                      silence_logs=logging.CRITICAL, env={"NUMBA_NUM_THREADS": "1"},
-                      preload=["swarmtopo._dask_plugin"]) as cluster:
-        with Client(cluster) as client:
-            yield client
 
 
 @lru_cache(maxsize=8)

@@ -101,6 +101,20 @@ class DaskEngine:
 
 
 @contextmanager
+def quiet_logs(*names: str) -> Iterator[None]:
+    """The named loggers at CRITICAL for the block's duration (their levels restored after)."""
+    loggers = [logging.getLogger(name) for name in names]
+    levels = [logger.level for logger in loggers]
+    for logger in loggers:
+        logger.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        for logger, level in zip(loggers, levels):
+            logger.setLevel(level)
+
+
+@contextmanager
 def connected_client(address: str):
     """A ``distributed.Client`` on the scheduler at ``address`` with at least one worker,
     every worker set up by :class:`~swarmtopo._dask_plugin.OneNumbaThread`; closed on exit.
@@ -114,22 +128,44 @@ def connected_client(address: str):
     except (OSError, ValueError, TypeError) as exc:
         raise SwarmtopoError(f"cannot connect to the Dask scheduler at {address!r} ({exc})") from None
     # a lost scheduler is the caller's one-line error: not the client's reconnection tracebacks
-    quiet = [logging.getLogger(name) for name in ("distributed.client", "distributed.utils")]
-    levels = [logger.level for logger in quiet]
-    for logger in quiet:
-        logger.setLevel(logging.CRITICAL)
-    try:
+    with quiet_logs("distributed.client", "distributed.utils"):
         try:
-            client.wait_for_workers(1, timeout=WORKER_WAIT)
-        except TimeoutError:
-            raise SwarmtopoError(f"the Dask scheduler at {address} has had no worker for "
-                                 f"{WORKER_WAIT:g} s; start some with: dask worker {address}") from None
+            try:
+                client.wait_for_workers(1, timeout=WORKER_WAIT)
+            except TimeoutError:
+                raise SwarmtopoError(f"the Dask scheduler at {address} has had no worker for "
+                                     f"{WORKER_WAIT:g} s; start some with: dask worker {address}") from None
+            client.register_plugin(OneNumbaThread())
+            yield client
+        finally:
+            client.close()
+
+
+@contextmanager
+def local_client(workers: int | None = None):
+    """A ``distributed.Client`` on a new local cluster of ``workers`` processes (default:
+    one per core) of one thread each, every worker set up by
+    :class:`~swarmtopo._dask_plugin.OneNumbaThread`; both closed on exit.
+
+    One core per worker: numba's parallel kernels would otherwise start one thread per
+    core in every worker (BLAS / OpenMP threads are already 1 under Dask's nanny).  The
+    scheduler's HTTP server takes any free port (8787 may be another cluster's).  The
+    workers preload swarmtopo._dask_plugin (its dask_setup: they ignore SIGINT, which the
+    client alone handles).  Only CRITICAL logs: a task's own exception reaches the client
+    through its future, and after Ctrl-C a worker may log an ERROR with a traceback while
+    the cluster shuts down, and the scheduler, which runs in this process, may race a
+    scatter (asyncio's "Task exception was never retrieved").
+    """
+    from distributed import Client, LocalCluster
+
+    from .._dask_plugin import OneNumbaThread
+
+    with quiet_logs("asyncio"), \
+            LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                         dashboard_address=":0", silence_logs=logging.CRITICAL, env={"NUMBA_NUM_THREADS": "1"},
+                         preload=["swarmtopo._dask_plugin"]) as cluster, Client(cluster) as client:
         client.register_plugin(OneNumbaThread())
         yield client
-    finally:
-        client.close()
-        for logger, level in zip(quiet, levels):
-            logger.setLevel(level)
 
 
 @contextmanager
@@ -137,31 +173,14 @@ def dask_engine(workers: int | None = None, scheduler: Any = None) -> Iterator[D
     """A :class:`DaskEngine` on the scheduler at ``scheduler`` (an address, or a
     ``distributed.Client`` the caller keeps), else on a new local cluster of ``workers``
     processes of one thread each (closed on exit)."""
-    from distributed import Client, LocalCluster
-
     from .._dask_plugin import OneNumbaThread
 
     if scheduler is not None and not isinstance(scheduler, str):
         scheduler.register_plugin(OneNumbaThread())
         yield DaskEngine(scheduler)
         return
-    if scheduler is not None:
-        with connected_client(scheduler) as client:
-            yield DaskEngine(client)
-        return
-    # the local scheduler runs in this process: after Ctrl-C its shutdown may race a scatter
-    # and asyncio would print "Task exception was never retrieved" with a traceback
-    asyncio_log = logging.getLogger("asyncio")
-    level = asyncio_log.level
-    asyncio_log.setLevel(logging.CRITICAL)
-    try:
-        with LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                          dashboard_address=":0", silence_logs=logging.CRITICAL, env={"NUMBA_NUM_THREADS": "1"},
-                          preload=["swarmtopo._dask_plugin"]) as cluster, Client(cluster) as client:
-            client.register_plugin(OneNumbaThread())
-            yield DaskEngine(client)
-    finally:
-        asyncio_log.setLevel(level)
+    with (connected_client(scheduler) if scheduler is not None else local_client(workers)) as client:
+        yield DaskEngine(client)
 
 
 @contextmanager
