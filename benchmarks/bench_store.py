@@ -125,6 +125,7 @@ def main() -> None:
     parser.add_argument("--sweep-only", action="store_true", help=argparse.SUPPRESS)  # part 4 in a fresh process
     args = parser.parse_args()
     if args.sweep_only:
+        print(f"# bench_store --sweep-only  {revision()}  {machine()}", flush=True)
         cheap_sweep(args.jobs, args.workers)
         return
     print(f"# bench_store  {revision()}  {machine()}\n")
