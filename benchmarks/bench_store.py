@@ -2,17 +2,17 @@
 
 1. Realistic rows: ``--realistic`` jobs of 200 agents x 120 s (random arenas, 1-3 square
    holes; the default map) swept on the local cluster with every window's diagram kept.
-   Bytes per row of its ``diagrams``: the JSON text the store held before
-   (``Diagram.to_json`` of every region and window) and the compressed BLOB for each
-   ``[sweep] diagrams`` level.  Then bytes per row on disk for each level: ``--copies``
+   Bytes per row of its ``diagrams``: as JSON text (``Diagram.to_json`` of every region
+   and window: the baseline) and as the compressed BLOB of each ``[sweep] diagrams``
+   level.  Then bytes per row on disk for each level: ``--copies``
    copies of each row (distinct keys, every value scaled by 1 + 1e-9 i so that no two
    copies share one) written to a fresh store ``SMALL_BATCH`` rows per transaction (a
    sweep of slow jobs writes a few rows a second; each write rewrites the table's last
    row group, which leaves freed blocks in the file), file size / rows, extrapolated to
    100,000 rows.
 2. Writing: the level-"map" copies of part 1 written one
-   transaction per row on a held connection with the diagrams as JSON text (what the
-   store did before; the baseline) and in batches of ``FLUSH_ROWS`` with the BLOB
+   transaction per row on a held connection with the diagrams as JSON text (the
+   baseline) and in batches of ``FLUSH_ROWS`` with the BLOB
    (``ResultStore.write``): rows per second and the ratio.
 3. Reading: level-"windows" stores of ``--stream-rows`` rows and twice as many (part 1's
    rows again under new keys) streamed back with ``iter_jobs`` (every column, every
@@ -61,8 +61,8 @@ def kept(regions, keep: str):
              **({"diagram": r["diagram"]} if keep != "none" else {})} for r in regions]
 
 
-def old_json(regions) -> str:
-    """The diagrams column as the store wrote it before: JSON, each Diagram as to_json."""
+def json_text(regions) -> str:
+    """The regions as JSON text, each Diagram as to_json (the baseline format)."""
     return json.dumps(regions, sort_keys=True, allow_nan=False,
                       default=lambda x: x.to_json() if isinstance(x, Diagram) else x)
 
@@ -109,7 +109,7 @@ def per_row_baseline(rows, path: Path) -> float:
         insert = f"INSERT INTO jobs VALUES ({', '.join('?' * len(names))})"
         start = time.perf_counter()
         for row in rows:
-            values = dict(row, diagrams=old_json(decode_regions(row["diagrams"])))
+            values = dict(row, diagrams=json_text(decode_regions(row["diagrams"])))
             db.execute(insert, [json.dumps(values[n], sort_keys=True) if n in ("config", "versions") else values[n]
                                 for n in names])
         return time.perf_counter() - start
@@ -118,7 +118,7 @@ def per_row_baseline(rows, path: Path) -> float:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--realistic", type=int, default=24, help="realistic jobs run (default 24)")
-    parser.add_argument("--copies", type=int, default=40, help="copies of each row written in part 2 (default 20)")
+    parser.add_argument("--copies", type=int, default=40, help="copies of each row written in parts 1 and 2 (default 40)")
     parser.add_argument("--stream-rows", type=int, default=4096, help="rows of the first store streamed in part 3")
     parser.add_argument("--jobs", type=int, default=SCALE, help="cheap jobs of the end-to-end sweep (0: skip)")
     parser.add_argument("--workers", type=int, default=2)
@@ -139,7 +139,7 @@ def main() -> None:
         print(f"1. {len(rows)} realistic rows (200 agents x 120 s, 1-3 holes, every window's diagram kept), "
               f"mapped in {time.perf_counter() - start:.0f} s on {args.workers} workers")
         regions = [row["diagrams"] for row in rows]
-        sizes = {"JSON before (every window)": [len(old_json(r).encode()) for r in regions]}
+        sizes = {"JSON text (every window)": [len(json_text(r).encode()) for r in regions]}
         for keep in KEEP_LEVELS:
             sizes[f"BLOB, diagrams = {keep!r}"] = [len(encode_regions(kept(r, keep))) for r in regions]
         for name, values in sizes.items():

@@ -4,7 +4,6 @@ Jobs made to crash, raise and hang come from tests/sweep_faults.py, which the Da
 workers started here (conftest.local_dask) and their job processes import.
 """
 
-import os
 import subprocess
 import sys
 import threading
@@ -15,7 +14,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from conftest import TESTS, free_port, local_dask, result_columns, run_cli, stop_group
+from conftest import free_port, local_dask, result_columns, run_cli, stop_group, tests_on_path
 from swarmtopo.errors import SwarmtopoError
 from swarmtopo.experiments.grid import expand_grid
 from swarmtopo.experiments.isolation import JobProcess
@@ -34,15 +33,10 @@ def cheap_jobs(name, replicates, salt=""):
     return expand_grid({"sweep": {"name": name, "replicates": replicates, "salt": salt}, **CHEAP}).jobs
 
 
-def plain(row):
-    """What a row says, run columns aside, diagrams decoded to JSON."""
-    return result_columns(row)
-
-
 @pytest.fixture
 def importable_tests(monkeypatch):
     """Job processes started by this process can import tests/sweep_faults.py."""
-    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [str(TESTS), os.environ.get("PYTHONPATH")])))
+    monkeypatch.setenv("PYTHONPATH", tests_on_path()["PYTHONPATH"])
 
 
 # -- the job process --------------------------------------------------------------------
@@ -109,13 +103,14 @@ def test_rows_keep_the_diagrams_asked_for_and_a_store_that_keeps_less_is_rerun(t
     again = run_sweep([job], store, keep="windows", workers=1)
     assert again.run == 1
     (row,) = read_jobs(store)
-    assert row["diagrams_kept"] == "windows" and plain(row) == plain(rows["windows"])
+    assert row["diagrams_kept"] == "windows" and result_columns(row) == result_columns(rows["windows"])
 
 
 def test_a_reader_in_another_process_and_the_writer_take_turns(tmp_path):
     store_path = tmp_path / "s.duckdb"
     store = ResultStore(store_path)
     rows = [run_job(job) for job in cheap_jobs("turns", 3)]
+    store.add_to_sweep("turns", [row["key"] for row in rows])
     assert store.write(rows[:1])
     holder = subprocess.Popen([sys.executable, "-c", "import duckdb, sys; db = duckdb.connect(sys.argv[1], "
                                "read_only=True); print('open', flush=True); sys.stdin.read()", str(store_path)],
@@ -123,7 +118,8 @@ def test_a_reader_in_another_process_and_the_writer_take_turns(tmp_path):
     try:
         assert holder.stdout.readline() == "open\n"
         assert not store.write(rows[1:], wait=0.3)  # held: nothing written, the caller keeps the rows
-        assert len(store_status(store_path).failures) == 0  # readers share the file
+        start = time.monotonic()  # readers share the file: status answers at once
+        assert store_status(store_path).sweeps[0].counts == {"ok": 1} and time.monotonic() - start < 5
     finally:
         holder.communicate("", timeout=30)
     assert store.write(rows[1:2])
@@ -148,7 +144,7 @@ def test_a_failed_row_never_replaces_a_good_one_and_rows_go_aside_when_the_store
     assert store.write([failed_row(job, "timeout", "ran past")]) and store.write([good])  # good replaces failed
     assert store.write([failed_row(job, "crashed", "killed")])  # ... but not the other way round
     (row,) = read_jobs(tmp_path / "s.duckdb")
-    assert row["status"] == "ok" and plain(row) == plain(good)
+    assert row["status"] == "ok" and result_columns(row) == result_columns(good)
     aside = store.save_aside([good])
     assert aside.parent == tmp_path and pq.read_table(aside).column("key").to_pylist() == [good["key"]]
 
@@ -164,18 +160,12 @@ def test_failures_group_by_kind_and_message_up_to_numbers():
 
 
 # -- bad jobs on a real scheduler and workers -------------------------------------------
-@pytest.fixture(scope="module")
-def cluster(tmp_path_factory):
-    with local_dask(tmp_path_factory.mktemp("dask")) as (address, _, _):
-        yield address
-
-
 @pytest.mark.slow
-def test_poison_jobs_are_rows_the_sweep_goes_on_and_retry_failed_reruns_them(tmp_path, cluster):
+def test_poison_jobs_are_rows_the_sweep_goes_on_and_retry_failed_reruns_them(tmp_path, dask_cluster):
     jobs = cheap_jobs("poison", 6, salt="poison")
     store = tmp_path / "s.duckdb"
     calls = []
-    summary = run_sweep(jobs, store, scheduler=cluster, job_timeout=5.0, runner=sweep_faults.faulty_job,
+    summary = run_sweep(jobs, store, scheduler=dask_cluster, job_timeout=5.0, runner=sweep_faults.faulty_job,
                         progress=lambda *a: calls.append(a))
     assert calls[0] == (0, 6, 0) and calls[-1][:2] == (6, 6), read_jobs(store, columns=("key", "error"))  # the total is known before the cluster is used
     assert (summary.run, summary.failed, summary.workers) == (6, {"crashed": 1, "error": 1, "timeout": 1}, 2), \
@@ -186,14 +176,14 @@ def test_poison_jobs_are_rows_the_sweep_goes_on_and_retry_failed_reruns_them(tmp
     assert rows[2]["status"] == "timeout" and rows[2]["error"].startswith("ran past the job timeout of 5 s")
     for r in (0, 1, 2):
         assert rows[r]["est_betti1"] is None and rows[r]["true_betti1"] is None and rows[r]["diagrams"] is None
-    reference = {job.key: plain(run_job(job)) for job in jobs}
+    reference = {job.key: result_columns(run_job(job)) for job in jobs}
     for r in (3, 4, 5):
-        assert plain(rows[r]) == reference[rows[r]["key"]]
+        assert result_columns(rows[r]) == reference[rows[r]["key"]]
     # a rerun skips failed rows; --retry-failed runs them again and replaces them
-    assert run_sweep(jobs, store, scheduler=cluster, runner=sweep_faults.faulty_job).run == 0
-    retried = run_sweep(jobs, store, scheduler=cluster, retry_failed=True)
+    assert run_sweep(jobs, store, scheduler=dask_cluster, runner=sweep_faults.faulty_job).run == 0
+    retried = run_sweep(jobs, store, scheduler=dask_cluster, retry_failed=True)
     assert (retried.run, retried.skipped, retried.failed) == (3, 3, {})
-    assert {row["key"]: plain(row) for row in read_jobs(store)} == reference
+    assert {row["key"]: result_columns(row) for row in read_jobs(store)} == reference
 
 
 @pytest.mark.slow
@@ -231,8 +221,8 @@ def test_a_worker_killer_inside_a_task_of_many_jobs_is_the_only_crashed_row(tmp_
     rows = read_jobs(tmp_path / "s.duckdb")
     (crashed,) = [row for row in rows if row["status"] == "crashed"]
     assert crashed["replicate"] == 15
-    assert {row["key"]: plain(row) for row in rows if row is not crashed} == \
-        {job.key: plain(run_job(job)) for job in jobs if job.replicate != 15}
+    assert {row["key"]: result_columns(row) for row in rows if row is not crashed} == \
+        {job.key: result_columns(run_job(job)) for job in jobs if job.replicate != 15}
 
 
 def _cli_sweep(toml, store, *extra):

@@ -523,6 +523,7 @@ def sweep(
     unless --retry-failed.  If every job of the grid failed, the sweep exits 1.
     """
     from .experiments.grid import read_sweep
+    from .experiments.store import stored_failures
     from .experiments.sweep import SchedulerLost, run_sweep
 
     _check_verbosity(quiet, verbose)
@@ -550,7 +551,7 @@ def sweep(
                   markup=False, highlight=False, soft_wrap=True)
         raise typer.Exit(1) from None
     # every job failed (the grid, not the data, is likely wrong): only then read the rows run before
-    failures = _stored_failures(store, grid.jobs) if summary.n_failed == summary.run else []
+    failures = stored_failures(store, [job.key for job in grid.jobs]) if summary.n_failed == summary.run else []
     if summary.total and sum(g.count for g in failures) == summary.total:
         first = failures[0]
         err.print(f"error: sweep {grid.name!r}: all {summary.total} jobs failed ({first.status}: {first.example}); "
@@ -562,7 +563,7 @@ def sweep(
         out.print(f"sweep {grid.name!r}: all {summary.total} jobs already in {store}; nothing to run",
                   markup=False, highlight=False)
         return
-    kinds = ", ".join(f"{n} {kind}" for kind, n in sorted(summary.failed.items()))
+    kinds = _kinds(summary.failed)
     out.print(f"sweep {grid.name!r}: {summary.total} jobs: {summary.run} run ({summary.n_failed} failed"
               f"{': ' + kinds if kinds else ''}), {summary.skipped} already in the store",
               markup=False, highlight=False)
@@ -571,6 +572,11 @@ def sweep(
     for line in _failure_lines(summary.failures):
         out.print(line, markup=False, highlight=False, soft_wrap=True)
     out.print(f"results: {store} (table jobs)", markup=False, highlight=False)
+
+
+def _kinds(counts: dict[str, int]) -> str:
+    """Failure kind -> count as "2 error, 1 timeout"."""
+    return ", ".join(f"{n} {kind}" for kind, n in sorted(counts.items()))
 
 
 def _failure_lines(groups, most: int = 3) -> list[str]:
@@ -583,33 +589,23 @@ def _failure_lines(groups, most: int = 3) -> list[str]:
     return lines
 
 
-def _stored_failures(store: Path, jobs):
-    """The failed rows stored for ``jobs`` (run now or before), grouped."""
-    from .experiments.store import group_failures, iter_jobs
-
-    rows = iter_jobs(store, keys=[job.key for job in jobs], columns=("key", "status", "error"))
-    return group_failures((row["status"], row["error"], 1) for row in rows if row["status"] != "ok")
-
-
 @app.command(epilog="Example: swarmtopo status results.duckdb  (while the sweep runs, from another terminal)")
 def status(
     store: Path = typer.Argument(..., help="A sweep's DuckDB result store."),
 ) -> None:
     """What a result store holds: per sweep, jobs done, failed (by kind) and pending; the
     most common failures; and whether a sweep is writing to it now."""
-    from datetime import datetime, timezone
-
-    from .experiments.store import RUN_STALE, store_status
+    from .experiments.store import RUN_STALE, store_status, utcnow
 
     found = store_status(store)
     for s in found.sweeps:
         failed = {k: n for k, n in s.counts.items() if k != "ok"}
-        kinds = ", ".join(f"{n} {kind}" for kind, n in sorted(failed.items()))
+        kinds = _kinds(failed)
         out.print(f"sweep {s.sweep!r}: {s.asked} jobs: {s.counts.get('ok', 0)} done, {sum(failed.values())} failed"
                   f"{' (' + kinds + ')' if kinds else ''}, {s.pending} pending", markup=False, highlight=False)
     for line in _failure_lines(found.failures, most=5):
         out.print(line, markup=False, highlight=False, soft_wrap=True)
-    now = datetime.now(timezone.utc).replace(tzinfo=None)
+    now = utcnow()
     for run in found.runs[-3:]:
         ago = (now - run["updated_at"]).total_seconds()
         where = f"{run['host']}:{run['pid']} on {run['scheduler']}, {run['workers']} worker(s)"

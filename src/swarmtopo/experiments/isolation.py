@@ -176,7 +176,7 @@ def _serve(parent: int) -> None:
     # the protocol's pipes on descriptors of their own: a call's prints go to stderr, and
     # a call that reads stdin (or a program it starts) reads an empty file
     replies = os.fdopen(os.dup(1), "wb")
-    requests = os.fdopen(os.dup(0), "rb")
+    requests = os.fdopen(os.dup(0), "rb", buffering=0)
     os.dup2(2, 1)
     null = os.open(os.devnull, os.O_RDONLY)
     os.dup2(null, 0)
@@ -185,8 +185,7 @@ def _serve(parent: int) -> None:
     threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
     while True:
         try:
-            (size,) = struct.unpack("<Q", _read_exactly(requests, 8))
-            request = _read_exactly(requests, size)
+            request = _receive(requests, None)
         except EOFError:
             return
         try:
@@ -196,13 +195,6 @@ def _serve(parent: int) -> None:
         except BaseException as exc:  # noqa: BLE001 - any failure of the call (SystemExit too) is its message
             payload = pickle.dumps(("error", one_line(exc)), protocol=pickle.HIGHEST_PROTOCOL)
         _send(replies, payload)
-
-
-def _read_exactly(stream, size: int) -> bytes:
-    data = stream.read(size)
-    if len(data) < size:
-        raise EOFError
-    return data
 
 
 def one_line(exc: BaseException) -> str:

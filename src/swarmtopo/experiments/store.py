@@ -206,7 +206,7 @@ class ResultStore:
     def __init__(self, path):
         self.path = Path(path)
         with _opened(self.path) as db:
-            if not _tables(db) & _TABLES:
+            if not _tables(db):
                 columns = ", ".join(f"{quoted} {sql}" for quoted, (_, sql) in zip(_QUOTED, JOB_COLUMNS))
                 db.execute("BEGIN")
                 db.execute(f"CREATE TABLE jobs ({columns})")
@@ -269,7 +269,7 @@ class ResultStore:
     def start_run(self, scheduler: str | None, workers: int) -> str:
         """Record a new run of a sweep on this store; its id."""
         run = f"{socket.gethostname()}:{os.getpid()}:{time.time_ns()}"
-        now = _utcnow()
+        now = utcnow()
         with _opened(self.path) as db:
             db.execute("INSERT INTO runs VALUES (?, ?, ?, ?, ?, ?, ?, NULL)",
                        [run, socket.gethostname(), os.getpid(), scheduler or "local", workers, now, now])
@@ -282,7 +282,7 @@ class ResultStore:
             return
         try:
             db.execute("UPDATE runs SET workers = ?, updated_at = ?, outcome = ? WHERE id = ?",
-                       [workers, _utcnow(), outcome, run])
+                       [workers, utcnow(), outcome, run])
         finally:
             db.close()
 
@@ -404,14 +404,24 @@ def read_jobs(path, sweep: str | None = None, columns: Sequence[str] | None = No
     return sorted(iter_jobs(path, sweep=sweep, columns=columns, keys=keys), key=lambda row: row["key"])
 
 
-def job_rows(path, jobs, columns: Sequence[str] | None = None) -> list[dict[str, Any]]:
+def job_rows(path, jobs) -> list[dict[str, Any]]:
     """The stored rows of these jobs (:func:`iter_jobs`), sorted by key."""
-    return read_jobs(path, columns=columns, keys=[job.key for job in jobs])
+    return read_jobs(path, keys=[job.key for job in jobs])
 
 
-def job_rows_each(path, *job_lists, columns: Sequence[str] | None = None) -> list[list[dict[str, Any]]]:
-    """The stored rows of each list of jobs, each sorted by key."""
-    return [job_rows(path, jobs, columns) for jobs in job_lists]
+def job_rows_each(path, *job_lists) -> list[list[dict[str, Any]]]:
+    """The stored rows of each list of jobs, from one read of the store, each sorted by key."""
+    rows = read_jobs(path, keys={job.key for jobs in job_lists for job in jobs})
+    return [[row for row in rows if row["key"] in keys] for keys in ({job.key for job in jobs} for jobs in job_lists)]
+
+
+def stored_failures(path, keys: Iterable[str]) -> list[FailureGroup]:
+    """The failed rows of these job keys, grouped (:func:`group_failures`), from one query."""
+    with _opened(Path(path), read_only=True) as db:
+        _check_schema(db, Path(path))
+        found = db.execute("SELECT status, error, count(*) FROM jobs WHERE key IN (SELECT unnest(?::TEXT[])) "
+                           "AND status <> 'ok' GROUP BY ALL", [list(keys)]).fetchall()
+    return group_failures(found)
 
 
 # -- status -------------------------------------------------------------------------------
@@ -440,9 +450,10 @@ def group_failures(failures: Iterable[tuple[str, str, int]]) -> list[FailureGrou
     largest first; each group's example is its first message in sorted order."""
     groups: dict[tuple[str, str], tuple[int, set[str]]] = {}
     for status, message, count in failures:
-        n, messages = groups.setdefault((status, message_pattern(message or "")), (0, set()))
+        key = (status, message_pattern(message or ""))
+        n, messages = groups.get(key, (0, set()))
         messages.add(message or "")
-        groups[status, message_pattern(message or "")] = (n + count, messages)
+        groups[key] = (n + count, messages)
     return sorted((FailureGroup(status, n, min(messages), len(messages) > 1)
                    for (status, _), (n, messages) in groups.items()),
                   key=lambda g: (-g.count, g.status, g.example))
@@ -499,7 +510,8 @@ def store_status(path) -> StoreStatus:
 
 
 # -- internals ----------------------------------------------------------------------------
-def _utcnow() -> datetime:
+def utcnow() -> datetime:
+    """Now in UTC without a time zone: how the store's TIMESTAMP columns hold time."""
     return datetime.now(timezone.utc).replace(tzinfo=None)
 
 

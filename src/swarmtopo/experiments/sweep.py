@@ -30,7 +30,6 @@ import time
 from collections import Counter, deque
 from contextlib import ExitStack
 from dataclasses import dataclass, field, replace
-from datetime import datetime, timezone
 from functools import lru_cache
 from typing import Any, Callable, Iterable
 
@@ -48,7 +47,7 @@ from ..viz.summary import window_json
 from ..sim import simulate
 from .grid import DEFAULT_JOB_TIMEOUT, KEEP_LEVELS, Job, flat_columns, job_map_config, job_simulation_args
 from .isolation import JobProcess, one_line
-from .store import JOB_COLUMNS, LOCK_WAIT, FailureGroup, ResultStore, encode_regions, group_failures
+from .store import JOB_COLUMNS, LOCK_WAIT, FailureGroup, ResultStore, encode_regions, group_failures, utcnow
 
 _STAGE_COLUMNS = {"graph": "t_graph", "landmarks": "t_landmarks", "persistence": "t_persistence",
                   "classify": "t_classify"}
@@ -186,30 +185,25 @@ def run_job(job: Job, keep: str = "map") -> dict[str, Any]:
         )
         row["versions"] = {**row["versions"], "classifier": tmap.classifier["classifier"],
                            "theta": tmap.classifier["theta"]}
-    row["finished_at"] = datetime.now(timezone.utc).replace(tzinfo=None)
+    row["finished_at"] = utcnow()
     row["t_total"] = time.perf_counter() - start
     return row
 
 
-def failed_row(job: Job, status: str, message: str, seconds: float | None = None, *,
-               in_client: bool = False) -> dict[str, Any]:
+def failed_row(job: Job, status: str, message: str, seconds: float | None = None) -> dict[str, Any]:
     """The row of a job that did not finish: ``status`` a failure kind (``FAILURES``),
-    the one-line ``message``, the truth and estimates NULL; its worker this process, or
-    unknown (NULL) for a row the client writes."""
+    the one-line ``message``, the truth and estimates NULL."""
     row = _identity_row(job)
     row.update(status=status, error=message, t_total=seconds)
-    if in_client:
-        row["worker"] = None
     return row
 
 
 def _identity_row(job: Job) -> dict[str, Any]:
-    """A row with the job's identity and grid columns, this process as its worker, the rest NULL."""
+    """A row with the job's identity and grid columns, the rest NULL (its ``worker`` is set
+    by :func:`run_isolated`: NULL in a row the client writes)."""
     row: dict[str, Any] = dict.fromkeys(name for name, _ in JOB_COLUMNS)
     row.update(key=job.key, sweep=job.sweep, replicate=job.replicate, salt=job.salt, seed=job.seed,
-               config=job.config, **flat_columns(job.config), versions=dict(_versions()),
-               worker=f"{socket.gethostname()}:{os.getpid()}",
-               finished_at=datetime.now(timezone.utc).replace(tzinfo=None))
+               config=job.config, **flat_columns(job.config), versions=dict(_versions()), finished_at=utcnow())
     return row
 
 
@@ -275,8 +269,6 @@ class SweepSummary:
         Jobs already in the store (not run again).
     run
         Jobs run and written now.
-    failed
-        Of those, rows of each failure kind (``FAILURES``) -> count.
     seconds
         Wall time of running them (cluster start included).
     workers
@@ -288,14 +280,21 @@ class SweepSummary:
     total: int
     skipped: int
     run: int
-    failed: dict[str, int]
     seconds: float
     workers: int
     failures: list[FailureGroup] = field(default_factory=list)
 
     @property
+    def failed(self) -> dict[str, int]:
+        """Of the jobs run, rows of each failure kind -> count."""
+        counts: Counter[str] = Counter()
+        for group in self.failures:
+            counts[group.status] += group.count
+        return dict(counts)
+
+    @property
     def n_failed(self) -> int:
-        return sum(self.failed.values())
+        return sum(group.count for group in self.failures)
 
     @property
     def jobs_per_minute(self) -> float:
@@ -385,7 +384,7 @@ def run_sweep(
         stored = store.stored()
         pending = [job for key, job in unique.items() if not _finished(stored.get(key), keep, retry_failed)]
         if not pending:
-            return SweepSummary(total=len(unique), skipped=len(unique), run=0, failed={}, seconds=0.0, workers=0)
+            return SweepSummary(total=len(unique), skipped=len(unique), run=0, seconds=0.0, workers=0)
         start = time.perf_counter()
         say(0, len(pending), 0)
         if client is None:
@@ -401,9 +400,9 @@ def run_sweep(
         finally:
             batch.close()
         return SweepSummary(total=len(unique), skipped=len(unique) - len(pending), run=batch.written,
-                            failed=dict(batch.failed), seconds=time.perf_counter() - start,
+                            seconds=time.perf_counter() - start,
                             workers=batch.workers, failures=group_failures(
-                                (status, message, 1) for status, message in batch.messages))
+                                (status, message, 1) for status, message in batch.failures))
 
 
 def _finished(stored: tuple[str, str | None] | None, keep: str, retry_failed: bool) -> bool:
@@ -427,8 +426,7 @@ class _Batches:
         self.run = store.start_run(scheduler, self.workers)
         self.rows: list[dict[str, Any]] = []
         self.written = 0
-        self.failed: Counter[str] = Counter()
-        self.messages: list[tuple[str, str]] = []
+        self.failures: list[tuple[str, str]] = []  # (status, error) of each failed row
         self.last = self.touched = time.monotonic()
         self.busy = False  # the last write found the file held by another process
         self.outcome = "finished"
@@ -436,8 +434,7 @@ class _Batches:
     def add(self, row: dict[str, Any]) -> None:
         self.rows.append(row)
         if row["status"] != "ok":
-            self.failed[row["status"]] += 1
-            self.messages.append((row["status"], row["error"]))
+            self.failures.append((row["status"], row["error"]))
         if len(self.rows) >= FLUSH_ROWS and not self.busy:
             self.flush()
 
@@ -447,10 +444,9 @@ class _Batches:
 
     def tick(self) -> None:
         """Write the rows if they have waited FLUSH_SECONDS; note the run alive if due."""
-        now = time.monotonic()
-        if self.rows and now - self.last >= FLUSH_SECONDS:
+        if self.rows and time.monotonic() - self.last >= FLUSH_SECONDS:
             self.flush()
-        elif now - self.touched >= TOUCH_SECONDS:
+        if time.monotonic() - self.touched >= TOUCH_SECONDS:
             self.touch()
 
     def flush(self, wait: float = 0.0) -> None:
@@ -462,8 +458,6 @@ class _Batches:
                 return  # the rows wait for the next turn
             del self.rows[:FLUSH_ROWS]
             self.written += len(chunk)
-        if time.monotonic() - self.touched >= TOUCH_SECONDS:
-            self.touch()
 
     def touch(self, outcome: str | None = None, wait: float = 0.0) -> None:
         self.touched = time.monotonic()
@@ -504,7 +498,6 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
     # in a task of several; suspects (their workers died in a task of their own) run alone
     queue: deque[tuple[Job, int | None]] = deque((job, None) for job in pending)
     suspects: deque[Job] = deque()
-    jobs_left = len(pending)  # jobs without a row yet
     window = max(IN_FLIGHT, 4 * sum(client.nthreads().values()))  # tasks in flight at most
     running: dict[str, tuple[Any, list[Job], int | None]] = {}  # task key -> (future, its jobs, deaths)
     seconds: list[float] = []  # the finished jobs' t_total
@@ -515,22 +508,19 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
     def submit() -> None:
         if any(deaths == 1 for _, _, deaths in running.values()):
             return  # a suspect runs: nothing beside it
+        tasks: list[tuple[list[Job], int | None]] = []
         if suspects:
-            if not running:
-                tasks = [([suspects.popleft()], 1)]
-                futures = client.map(run_isolated, [tasks[0][0]], key=[_task_key(tasks[0], settings)],
-                                     keep=keep, timeout=timeout, runner=runner)
-                running[futures[0].key] = (futures[0], *tasks[0])
-                finished.update(futures)
-            return
-        size = _jobs_per_task(seconds)
-        tasks = []
-        while queue and len(running) + len(tasks) < window:
-            job, deaths = queue.popleft()
-            task = [job]
-            while deaths is None and len(task) < size and queue and queue[0][1] is None:
-                task.append(queue.popleft()[0])
-            tasks.append((task, deaths))
+            if running:
+                return  # a suspect waits for the cluster to empty
+            tasks.append(([suspects.popleft()], 1))
+        else:
+            size = _jobs_per_task(seconds)
+            while queue and len(running) + len(tasks) < window:
+                job, deaths = queue.popleft()
+                task = [job]
+                while deaths is None and len(task) < size and queue and queue[0][1] is None:
+                    task.append(queue.popleft()[0])
+                tasks.append((task, deaths))
         if tasks:
             futures = client.map(run_isolated, [task for task, _ in tasks], key=[_task_key(t, settings) for t in tasks],
                                  keep=keep, timeout=timeout, runner=runner)
@@ -546,7 +536,7 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
                 done = finished.next_batch(block=False)
                 if not done:
                     if client.status != "running":
-                        raise SchedulerLost(address, batch.done, jobs_left, "connection closed")
+                        raise SchedulerLost(address, batch.done, len(pending) - batch.done, "connection closed")
                     time.sleep(POLL_SECONDS)
                     batch.tick()
                 for future in done:
@@ -554,7 +544,6 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
                     try:
                         rows = future.result()
                     except KilledWorker as exc:
-                        future.release()
                         if len(task) > 1:  # which of them? each in a task of its own
                             queue.extendleft((job, 0) for job in reversed(task))
                             continue
@@ -562,19 +551,19 @@ def _run_pending(client, pending: list[Job], batch: _Batches, say, *, keep, time
                             suspects.append(task[0])
                             continue
                         rows = [failed_row(task[0], "crashed", "its workers died running it alone on the "
-                                           f"cluster ({one_line(exc)})", in_client=True)]
+                                           f"cluster ({one_line(exc)})")]
                     except CancelledError:
-                        raise SchedulerLost(address, batch.done, jobs_left,
+                        raise SchedulerLost(address, batch.done, len(pending) - batch.done,
                                             "its tasks were cancelled: scheduler-connection-lost") from None
                     except Exception as exc:  # noqa: BLE001 - a task's own failure is its jobs' rows
-                        rows = [failed_row(job, "error", one_line(exc), in_client=True) for job in task]
-                    future.release()
+                        rows = [failed_row(job, "error", one_line(exc)) for job in task]
+                    finally:
+                        future.release()
                     for row in rows:
                         batch.add(row)
-                        jobs_left -= 1
                         if row["t_total"] is not None:
                             seconds.append(row["t_total"])
-                    say(batch.done, len(pending), sum(batch.failed.values()))
+                    say(batch.done, len(pending), len(batch.failures))
                 batch.tick()
                 if len(running) < window // 2 or suspects:
                     submit()
