@@ -253,7 +253,7 @@ def result_columns(row):
     return json.loads(json.dumps(out, default=lambda x: x.to_json() if isinstance(x, Diagram) else str(x)))
 
 
-def tests_on_path() -> dict[str, str]:
+def pythonpath_with_tests() -> dict[str, str]:
     """This process's environment with this folder first on PYTHONPATH (for the processes
     it starts: Dask schedulers and workers, and the job processes of workers)."""
     return {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(TESTS), os.environ.get("PYTHONPATH")]))}
@@ -268,7 +268,7 @@ def local_dask(logs: Path, workers: int = 2, nanny: bool = True):
     from distributed import Client
 
     address = f"tcp://127.0.0.1:{free_port()}"
-    env = tests_on_path()
+    env = pythonpath_with_tests()
     procs = []
     try:
         procs.append(subprocess.Popen(

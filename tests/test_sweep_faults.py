@@ -14,7 +14,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from conftest import free_port, local_dask, result_columns, run_cli, stop_group, tests_on_path
+from conftest import free_port, local_dask, result_columns, run_cli, stop_group, pythonpath_with_tests
 from swarmtopo.errors import SwarmtopoError
 from swarmtopo.experiments.grid import expand_grid
 from swarmtopo.experiments.isolation import JobProcess
@@ -36,7 +36,7 @@ def cheap_jobs(name, replicates, salt=""):
 @pytest.fixture
 def importable_tests(monkeypatch):
     """Job processes started by this process can import tests/sweep_faults.py."""
-    monkeypatch.setenv("PYTHONPATH", tests_on_path()["PYTHONPATH"])
+    monkeypatch.setenv("PYTHONPATH", pythonpath_with_tests()["PYTHONPATH"])
 
 
 # -- the job process --------------------------------------------------------------------
