@@ -20,6 +20,7 @@ The public names (loaded on first use, so ``import swarmtopo`` stays light):
 ``TopologicalMap``   the result; ``map_json`` gives its map.json document
 ``write_map``        map.json, report.html and figures into a folder
 ``Arena``            free space as polygons; ``random_arena``, ``default_arena``, ``read_arena``
+``ChangingArena``    an arena whose obstacles come and go (``TimedObstacle``); ``changing_arena``
 ``EncounterLog``     the events a base station receives
 ``load_classifier``  a Betti reader by preset name (default, trace, paper) or file
 ``SwarmtopoError``, ``InputError``, ``ArenaError``   what bad input raises
@@ -48,6 +49,9 @@ _PUBLIC = {
     "Arena": "swarmtopo.arena",
     "random_arena": "swarmtopo.arena",
     "default_arena": "swarmtopo.arena",
+    "ChangingArena": "swarmtopo.changing",
+    "TimedObstacle": "swarmtopo.changing",
+    "changing_arena": "swarmtopo.changing",
     "EncounterLog": "swarmtopo.log",
     "load_classifier": "swarmtopo.readers.registry",
     "SwarmtopoError": "swarmtopo.errors",

@@ -55,6 +55,8 @@ out = Console()
 err = Console(stderr=True)
 DEMO_AGENTS, DEMO_SECONDS = 200, 30.0
 """The demo's swarm: the accuracy benchmark's smallest budget."""
+CHANGING_DEMO_SWARM = (300, 120.0)
+"""``demo --changing``'s swarm: agents and seconds (the second hole appears at 60 s)."""
 DEMO_WRITER = "swarmtopo demo"
 """``written_by`` in the meta.json of the demo's log: the only log demo may replace."""
 MAX_SCALE = 1000.0
@@ -201,6 +203,7 @@ def simulate(
     import time
 
     from .arena import random_arena
+    from .changing import ChangingArena, true_betti_text
     from .io.arenas import read_arena
     from .io.logs import write_log
     from .sim import (MotionParams, SensingParams, check_run_size, check_static_time, check_time_step,
@@ -242,8 +245,15 @@ def simulate(
     _say_removed(stage, quiet)
     if not quiet:
         b0, b1 = world.betti
-        out.print(f"{sim.log.n_events} encounters of {agents} agents over {sim.log.meta['duration']:g} s "
-                  f"in an arena with {b0} region(s) and {b1} hole(s)")
+        where = (f"in an arena that changes ({true_betti_text(world, sim.log.meta['duration'])})"
+                 if isinstance(world, ChangingArena) else f"in an arena with {b0} region(s) and {b1} hole(s)")
+        out.print(f"{sim.log.n_events} encounters of {agents} agents over {sim.log.meta['duration']:g} s {where}",
+                  markup=False, highlight=False, soft_wrap=True)
+        for moved in sim.log.meta["simulation"].get("relocated", []):
+            if moved["agents"]:
+                out.print(f"at t = {moved['t']:g} s the arena changed: {moved['agents']} agent(s) stood where an "
+                          "obstacle appeared and were moved to the nearest free point", markup=False, highlight=False,
+                          soft_wrap=True)
         out.print(f"wrote {', '.join(str(p) for p in written)}", markup=False, highlight=False, soft_wrap=True)
 
 
@@ -372,6 +382,13 @@ def map_command(
         "(default): the bands the reader was fitted with, 1,0.5 for the default reader and 1 for the others)."),
     max_landmarks: Optional[str] = _map_option(
         "max_landmarks", "L", "Cap of the automatic landmark count per region and window, 3..2000 (default 400)."),
+    timeline_length: Optional[str] = _map_option(
+        "timeline_length", "SECONDS|auto|none",
+        "Seconds of the time windows of the map's timeline, which says whether and when the Betti numbers "
+        "changed ('auto' (default): the map's own windows, read one by one; 'none': no timeline)."),
+    timeline_step: Optional[str] = _map_option(
+        "timeline_step", "SECONDS|auto", "Seconds between the starts of the timeline's windows of its own (with "
+                                         "this or --timeline-length; default half one)."),
     classifier: Optional[str] = typer.Option(
         None, "--classifier",
         help="Betti reader: default (tuned on the accuracy benchmark), trace (the same tuned on its logs read as "
@@ -407,7 +424,8 @@ def map_command(
                "seed": seed, "hop_cost": hop_cost, "diffusion_time": diffusion_time,
                "wall_follow_weight": wall_follow_weight, "window_length": window_length,
                "window_encounters": window_encounters, "window_scales": window_scales, "window_step": window_step,
-               "max_windows": max_windows, "landmark_bands": landmark_bands, "max_landmarks": max_landmarks}
+               "max_windows": max_windows, "landmark_bands": landmark_bands, "max_landmarks": max_landmarks,
+               "timeline_length": timeline_length, "timeline_step": timeline_step}
     if paper:
         given = [_option_name(name) for name in PAPER_EXCLUDES if options[name] is not None]
         if given or classifier is not None:
@@ -443,6 +461,9 @@ def demo(
                                  help="Output folder: the log in its log/, the map beside it (a log and map already "
                                       "there are replaced only if demo wrote them; other files stay)."),
     seed: int = typer.Option(0, "--seed", min=0, help="Random seed."),
+    changing: bool = typer.Option(False, "--changing",
+                                  help="An arena that changes: a second hole appears at t = 60 s (300 agents, 120 s); "
+                                       "the map's timeline says when."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
@@ -450,9 +471,11 @@ def demo(
 
     A 500 mm square with one hole, 200 agents, 30 s of data (the accuracy benchmark's
     smallest budget; the paper's figure has 20 s): prints the recovered
-    Betti numbers beside the true ones and where the figures were written.
+    Betti numbers beside the true ones and where the figures were written.  With
+    --changing, a second hole appears half-way through a longer log.
     """
     from .arena import default_arena
+    from .changing import changing_demo_arena, true_betti_text
     from .io.logs import log_files, write_log
     from .pipeline import MapConfig
     from .sim import simulate as run
@@ -466,20 +489,21 @@ def demo(
             if found:
                 raise SwarmtopoError(f"{folder}: already holds a {what} that swarmtopo demo did not write "
                                      f"({', '.join(p.name for p in found)}); choose another --out")
-    world = default_arena()
+    world, agents, seconds = ((changing_demo_arena(), *CHANGING_DEMO_SWARM) if changing
+                              else (default_arena(), DEMO_AGENTS, DEMO_SECONDS))
     owned = {"log": [p.name for p in log_files(log_dir)], **dict.fromkeys(MAP_FILES)}  # the rest of D stays
     with output.staged_folder(out_dir, owned, what="demo", overwrite=True) as stage:
         with _progress("simulating", quiet) as tick:
-            sim = run(world, DEMO_AGENTS, DEMO_SECONDS, rng=seed, truth=True, trajectory_every=0.5, progress=tick)
+            sim = run(world, agents, seconds, rng=seed, truth=True, trajectory_every=0.5, progress=tick)
         sim.log.meta["written_by"] = DEMO_WRITER
         write_log(sim.log, stage.path / "log", truth=sim.truth, trajectories=sim.trajectories, arena=world)
         if verbose:
-            _detail(f"simulated: {sim.log.n_events} encounters of {DEMO_AGENTS} agents over {DEMO_SECONDS:g} s; "
+            _detail(f"simulated: {sim.log.n_events} encounters of {agents} agents over {seconds:g} s; "
                     f"log: {log_dir}")
         tmap, written = _run_map(sim.log, MapConfig(seed=seed), log_dir, stage.path, quiet, verbose,
                                  ground_truth=(world, sim.truth, sim.trajectories))
     if not quiet:
-        _print_verdict(tmap, truth=world.betti)
+        _print_verdict(tmap, truth=true_betti_text(world, sim.log.meta["duration"]))
         out.print(f"log: {log_dir}", markup=False, highlight=False, soft_wrap=True)
         out.print(f"wrote {', '.join(str(stage.final_path(p)) for p in written)}", markup=False, highlight=False,
                   soft_wrap=True)
@@ -746,6 +770,50 @@ def _plan_input_option(value: str) -> str:
     return value
 
 
+@bench_app.command("timeline", epilog="Example: swarmtopo bench timeline --quick --store timeline.duckdb --workers 2  "
+                                      "(run it again after Ctrl-C: finished maps are kept)")
+def bench_timeline(
+    quick: bool = typer.Option(False, "--quick", help="5 cases per cell instead of 20."),
+    store: Path = typer.Option(Path("timeline.duckdb"), "--store", help="DuckDB result store (resumable)."),
+    out_dir: Path = typer.Option(Path("timeline"), "--out", help="Folder for timeline.md and timeline.json."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Address of an existing Dask scheduler."),
+    workers: Optional[int] = typer.Option(None, "--workers", min=1,
+                                          help="Worker processes of the local cluster (default: all cores)."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
+) -> None:
+    """How well the map's timeline finds changes of the arena, and how rarely it invents them.
+
+    Simulates arenas where a hole appears, a hole disappears or a door closes at a
+    random time (200-400 agents, 120-300 s), and static controls; maps each log
+    stripped of ground truth on Dask; prints the share of changes found (within 15 s),
+    the error of the change time, and the false change points.
+    """
+    import shlex
+    import time
+
+    from ._json import write_json
+    from .experiments.timeline import markdown, run_benchmark
+
+    _check_verbosity(quiet, verbose)
+    command = "swarmtopo " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+    start = time.perf_counter()
+    with output.staged_folder(out_dir, ("timeline.json", "timeline.md"), what="timeline report", overwrite=True,
+                              note=f"finished maps are saved in {store}; run the same command again to run the "
+                                   "rest") as stage:
+        with _sweep_progress(quiet, verbose, label="timeline") as tick:
+            summary = run_benchmark(store, quick=quick, scheduler=scheduler, workers=workers, progress=tick)
+        summary["wall_seconds"] = time.perf_counter() - start
+        text = markdown(summary, command)
+        written = [write_json(summary, stage.path / "timeline.json")]
+        (stage.path / "timeline.md").write_text(text, encoding="utf-8")
+        written.append(stage.path / "timeline.md")
+    if not quiet:
+        out.print(text, markup=False, highlight=False, soft_wrap=True)
+        out.print(f"wrote {', '.join(str(stage.final_path(p)) for p in written)}", markup=False, highlight=False,
+                  soft_wrap=True)
+
+
 @app.command(epilog="Examples: swarmtopo plan --area 250000 --agents 200 --duration 30;  "
                     "swarmtopo plan --area 250000 --agents 200 --target 0.95 --holes 3;  "
                     "swarmtopo plan --input contact-trace --area 250000 --agents 200 --duration 60")
@@ -918,10 +986,23 @@ def _print_verdict(tmap, truth) -> None:
     est = ", ".join(f"beta_{n} = {b}{confidence(n)}" if b is not None else
                     f"beta_{n} not estimated (the classifier has no threshold for it)"
                     for n, b in sorted(tmap.betti.items()))
-    say(f"recovered: {est}")
+    timeline = tmap.timeline
+    if timeline is not None and timeline.changes:
+        say(f"recovered: the arena changed: {timeline.summary()}")
+        for c in timeline.changes:
+            sure = "" if c.confidence is None else f"; {format_confidence(c.confidence)} confidence"
+            say(f"change:    beta_{c.dim} from {c.before} to {c.after} at about {c.t:.0f} s "
+                f"(between {c.lo:.0f} and {c.hi:.0f} s{sure})")
+        say(f"pooled:    {est}, over the whole log (mixing before and after)")
+    else:
+        say(f"recovered: {est}")
+        if timeline is not None:
+            say(f"timeline:  {timeline.note or timeline.summary()}")
     if truth is not None:
-        say(f"true:      beta_0 = {truth[0]}, beta_1 = {truth[1]}")
+        say(f"true:      {truth}")
     for warning in tmap.warnings:
+        if timeline is not None and timeline.changes and warning.startswith("the Betti numbers changed"):
+            continue  # said above
         say(f"warning: {warning}")
     for line in advice(tmap):
         say(f"advice: {line}")

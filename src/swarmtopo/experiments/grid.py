@@ -10,14 +10,17 @@ Format (``examples/sweep-small.toml`` is a commented example)::
     diagrams = "map"          # diagrams each row keeps: none | map | windows (default "map")
 
     [arena]
-    generator = "random"      # random | default | square | annulus | two_rooms | file
+    generator = "random"      # random | default | square | annulus | two_rooms | file | changing
     holes = [1, 2, 3]         # random, two_rooms: number of holes (default 1)
     shapes = "square"         # random, two_rooms: hole families (default "square")
     outer = "square"          # random: outer wall square | rectangle | polygon
     scale = [0.75, 1.0]       # all: scale factor of every length (default 1.0)
     r_outer = 250.0           # annulus: outer radius, mm (default 250)
     r_inner = 150.0           # annulus: inner radius, mm (default 150)
-    path = "arena.geojson"    # file: GeoJSON arena, relative to the TOML file
+    path = "arena.geojson"    # file: GeoJSON arena (a changing one too), relative to the TOML file
+    change = "appear"         # changing: none | appear (a hole appears) | disappear | door (a door
+                              # closes between two rooms): swarmtopo.changing.changing_arena
+    change_time = 60.0        # changing: when, s (before the swarm's duration)
 
     [swarm]
     agents = 200              # swarm size N (default 200)
@@ -86,6 +89,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..arena import HOLE_SHAPES, OUTER_SHAPES
+from ..changing import CHANGES
 from ..readers.registry import PRESETS, load_classifier
 from ..errors import InputError, SwarmtopoError
 from ..io import read_arena
@@ -99,6 +103,7 @@ GENERATORS: dict[str, tuple[str, ...]] = {
     "annulus": ("r_outer", "r_inner", "scale"),
     "two_rooms": ("holes", "shapes", "scale"),
     "file": ("path", "scale"),
+    "changing": ("holes", "shapes", "outer", "scale", "change", "change_time"),
 }
 """Arena generators and the ``[arena]`` keys each one uses (besides ``generator``)."""
 STREAMS = ("arena", "simulation", "map")
@@ -196,6 +201,8 @@ PARAMS: tuple[Param, ...] = (
     Param("arena", "r_outer", 250.0, _number(0.0, strict=True), "DOUBLE"),
     Param("arena", "r_inner", 150.0, _number(0.0, strict=True), "DOUBLE"),
     Param("arena", "path", None, _text, "TEXT"),
+    Param("arena", "change", "appear", _choice(CHANGES), "TEXT"),
+    Param("arena", "change_time", 60.0, _number(0.0, strict=True), "DOUBLE"),
     Param("swarm", "agents", 200, _integer(1), "INTEGER"),
     Param("swarm", "duration", 20.0, _number(0.0, strict=True), "DOUBLE"),
     Param("swarm", "static_fraction", 0.0, _number(0.0, strict=False, hi=1.0), "DOUBLE"),
@@ -424,13 +431,14 @@ def expand_grid(document: dict, *, source: str = "<grid>", base_dir=None,
 def flat_columns(config: dict) -> dict[str, Any]:
     """One value per ``PARAMS`` key: None where the config does not use it and for "auto"
     (from the data), inf for "none" in a number column (``diffusion_time``,
-    ``wall_follow_weight`` and ``window_length``: the paper's weights, the whole log): the
+    ``wall_follow_weight`` and ``window_length``: the paper's weights, the whole log), None
+    for "none" in another column but ``change`` (where "none" is a kind of change): the
     store's flattened grid columns."""
     flat = {}
     for p in PARAMS:
         value = config.get(p.table, {}).get(p.name)
         flat[p.name] = (float("inf") if value == "none" and p.sql == "DOUBLE"
-                        else None if value in ("auto", "none") else value)
+                        else None if value == "auto" or (value == "none" and p.name != "change") else value)
     return flat
 
 
@@ -515,6 +523,12 @@ def _canonical(point: dict, inputs: _InputFiles, fail):
             fail("[arena] path", 'missing: generator = "file" needs the path of a GeoJSON arena')
         absolute, arena["path_sha256"] = inputs.resolve("[arena] path", arena["path"], read_arena)
         files.append(("arena.path", absolute))
+    if generator == "changing":
+        if arena["change"] == "none":
+            del arena["change_time"]
+        elif arena["change_time"] >= point[("swarm", "duration")]:
+            fail(f"[arena] change_time = {_toml(arena['change_time'])}",
+                 f"must be before the end of the log (duration = {point[('swarm', 'duration')]:g})")
     if generator == "annulus" and arena["r_inner"] >= arena["r_outer"]:
         fail(f"[arena] r_inner = {_toml(arena['r_inner'])}", f"must be smaller than r_outer = {arena['r_outer']:g}")
 

@@ -12,7 +12,9 @@ Tables
     against the true beta_1 (``snr_h1`` = the paper's ratio, ``noise_power_h1``) and bar
     lengths (``lengths_h1``, decreasing), the regions (``diagrams``: a compressed BLOB,
     see :func:`encode_regions`; ``diagrams_kept`` says which persistence diagrams it
-    holds, :data:`~.grid.KEEP_LEVELS`), sizes (``n_events, n_agents, n_regions, n_landmarks``),
+    holds, :data:`~.grid.KEEP_LEVELS`), ``timeline`` JSON (the true Betti numbers over time,
+    the map's change points and segments, and at level ``windows`` each timeline window's
+    counts: :func:`~.sweep.timeline_record`), sizes (``n_events, n_agents, n_regions, n_landmarks``),
     stage timings in seconds (``t_simulate, t_graph, t_landmarks, t_persistence,
     t_classify, t_total``), ``versions`` JSON (software versions, and the classifier's
     name and Theta), ``worker`` (host:pid), ``finished_at`` (UTC), ``status`` and
@@ -70,7 +72,7 @@ _RESULTS = (
     ("est_betti0", "INTEGER"), ("est_betti1", "INTEGER"),
     ("confidence_betti0", "DOUBLE"), ("confidence_betti1", "DOUBLE"),
     ("snr_h1", "DOUBLE"), ("noise_power_h1", "DOUBLE"), ("lengths_h1", "DOUBLE[]"),
-    ("diagrams", "BLOB"), ("diagrams_kept", "TEXT"),
+    ("diagrams", "BLOB"), ("diagrams_kept", "TEXT"), ("timeline", "JSON"),
     ("n_events", "INTEGER"), ("n_agents", "INTEGER"), ("n_regions", "INTEGER"), ("n_landmarks", "INTEGER"),
     ("t_simulate", "DOUBLE"), ("t_graph", "DOUBLE"), ("t_landmarks", "DOUBLE"), ("t_persistence", "DOUBLE"),
     ("t_classify", "DOUBLE"), ("t_total", "DOUBLE"),
@@ -79,7 +81,7 @@ _RESULTS = (
 )
 JOB_COLUMNS: tuple[tuple[str, str], ...] = (*_IDENTITY, *((p.name, p.sql) for p in PARAMS), *_RESULTS)
 """(name, DuckDB type) of every column of ``jobs``, in order."""
-JSON_COLUMNS = ("config", "versions")
+JSON_COLUMNS = ("config", "versions", "timeline")
 """Columns holding JSON text; :func:`iter_jobs` returns them parsed."""
 RUN_COLUMNS = ("t_simulate", "t_graph", "t_landmarks", "t_persistence", "t_classify", "t_total",
                "versions", "worker", "finished_at")
@@ -214,6 +216,7 @@ class ResultStore:
                 db.execute("CREATE TABLE runs (id TEXT PRIMARY KEY, host TEXT, pid INTEGER, scheduler TEXT, "
                            "workers INTEGER, started_at TIMESTAMP, updated_at TIMESTAMP, outcome TEXT)")
                 db.execute("COMMIT")
+            _add_new_columns(db)
             _check_schema(db, self.path)
         # a retried job's new row replaces the old one, but a failed row never replaces a
         # good one (a job rerun to keep more diagrams that then crashed keeps its result)
@@ -520,6 +523,23 @@ def _tables(db) -> set[str]:
     return {name for (name,) in db.execute("SELECT table_name FROM information_schema.tables").fetchall()} & _TABLES
 
 
+NEW_COLUMNS = ("change", "change_time", "timeline")
+"""Columns added since stores had a runs table: a store without them gets them (NULL)
+when a sweep opens it, so its finished jobs are kept."""
+
+
+def _add_new_columns(db) -> None:
+    """Add ``NEW_COLUMNS`` missing from an existing jobs table (one transaction)."""
+    if _tables(db) != _TABLES:
+        return
+    missing = [name for name in NEW_COLUMNS if name not in _job_columns(db)]
+    if missing:
+        db.execute("BEGIN")
+        for name in missing:
+            db.execute(f'ALTER TABLE jobs ADD COLUMN "{name}" {dict(JOB_COLUMNS)[name]}')
+        db.execute("COMMIT")
+
+
 def _check_schema(db, path: Path, columns: Sequence[str] | None = None) -> None:
     """Refuse a file whose tables are not this version's store (with ``columns``: whose
     jobs table lacks one of them)."""
@@ -536,7 +556,7 @@ def _check_schema(db, path: Path, columns: Sequence[str] | None = None) -> None:
                                  "use a new store file")
         raise SwarmtopoError(f"{path}: not a sweep result store (it lacks the jobs and sweep_jobs tables)")
     found = _job_columns(db)
-    if found != _NAMES:
+    if set(found) != set(_NAMES):
         missing = [n for n in _NAMES if n not in found]
         extra = [n for n in found if n not in _NAMES]
         raise SwarmtopoError(

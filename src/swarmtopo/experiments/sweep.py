@@ -21,6 +21,7 @@ after the finished rows are written.
 
 from __future__ import annotations
 
+import math
 import os
 import socket
 import tempfile
@@ -34,6 +35,7 @@ from functools import lru_cache
 from typing import Any, Callable, Iterable
 
 from ..arena import Arena, annulus_arena, default_arena, random_arena, square_arena, two_rooms_arena
+from ..changing import ChangingArena, betti_timeline_of, changing_arena
 from ..readers.base import BettiReader
 from ..readers.registry import PRESETS, load_classifier
 from ..errors import SwarmtopoError
@@ -43,7 +45,7 @@ from ..topology.persistence import snr
 from ..pipeline import MapConfig, map_encounters
 from ..pipeline.engine import POLL_SECONDS, connected_client, deferred_interrupt, local_client
 from ..pipeline.result import software_versions
-from ..viz.summary import window_json
+from ..viz.summary import timeline_json, window_json
 from ..sim import simulate
 from .grid import DEFAULT_JOB_TIMEOUT, KEEP_LEVELS, Job, flat_columns, job_map_config, job_simulation_args
 from .isolation import JobProcess, one_line
@@ -53,7 +55,7 @@ _STAGE_COLUMNS = {"graph": "t_graph", "landmarks": "t_landmarks", "persistence":
                   "classify": "t_classify"}
 
 
-def build_arena(arena: dict[str, Any], rng, path: str | None = None) -> Arena:
+def build_arena(arena: dict[str, Any], rng, path: str | None = None) -> Arena | ChangingArena:
     """The arena of a canonical ``config["arena"]`` (see :mod:`.grid`).
 
     Parameters
@@ -66,6 +68,9 @@ def build_arena(arena: dict[str, Any], rng, path: str | None = None) -> Arena:
         Absolute path of the GeoJSON file (``generator = "file"``).
     """
     generator, scale = arena["generator"], arena["scale"]
+    if generator == "changing":
+        return changing_arena(arena["change"], arena["holes"], arena.get("change_time", math.inf), shapes=arena["shapes"],
+                              outer=arena["outer"], scale=scale, rng=rng)
     if generator == "random":
         return random_arena(arena["holes"], scale=scale, shapes=arena["shapes"], outer=arena["outer"], rng=rng)
     if generator == "two_rooms":
@@ -159,6 +164,7 @@ def run_job(job: Job, keep: str = "map") -> dict[str, Any]:
         sim = simulate(arena, **job_simulation_args(swarm), rng=seeds["simulation"])
         row["t_simulate"] = time.perf_counter() - t0
         row["n_events"], row["n_agents"] = sim.log.n_events, sim.log.n_agents
+        true_timeline = betti_timeline_of(arena, sim.log.meta["duration"])
         log = stripped_log(sim.log)
         tmap = map_encounters(contact_trace(log) if map_input(mapping) == "contact-trace" else log,
                               job_map_config(mapping, seeds["map"]),
@@ -180,6 +186,7 @@ def run_job(job: Job, keep: str = "map") -> dict[str, Any]:
             snr_h1=ratio.ratio, noise_power_h1=ratio.noise_power,
             lengths_h1=[float(x) for x in tmap.diagram.lengths(1)],
             diagrams=encode_regions(regions), diagrams_kept=keep,
+            timeline=timeline_record(tmap.timeline, true_timeline, keep),
             n_regions=len(tmap.regions), n_landmarks=sum(region["landmarks"] for region in regions),
             **{column: tmap.timings[stage] for stage, column in _STAGE_COLUMNS.items()},
         )
@@ -188,6 +195,18 @@ def run_job(job: Job, keep: str = "map") -> dict[str, Any]:
     row["finished_at"] = utcnow()
     row["t_total"] = time.perf_counter() - start
     return row
+
+
+def timeline_record(timeline, truth: list[dict[str, Any]], keep: str) -> dict[str, Any]:
+    """A row's ``timeline`` column: the true Betti timeline, the map's change points and
+    segments, and (``keep = "windows"``) each timeline window's t0, t1, counts and
+    confidences (what re-segmenting with another penalty needs)."""
+    found = timeline_json(timeline)
+    record = {"truth": truth, "changes": found["changes"], "segments": found["segments"],
+              "length": found["length"], "step": found["step"]}
+    if keep == "windows":
+        record["windows"] = [{k: w[k] for k in ("t0", "t1", "betti", "confidence")} for w in found["windows"]]
+    return record
 
 
 def failed_row(job: Job, status: str, message: str, seconds: float | None = None) -> dict[str, Any]:

@@ -120,6 +120,13 @@ class MapConfig:
         Dimension of the MDS picture: 3, 2, or 0 for no picture (sweeps).
     cycles
         Find a representative loop of landmarks for each counted H1 bar.
+    timeline_length
+        Length (s) of the windows of the map's timeline (:mod:`.timeline`): None
+        (default) = the map's own windows, read one by one (or, with ``timeline_step``
+        set, windows of the window length W); ``WHOLE_LOG`` (inf) = no timeline.
+    timeline_step
+        Seconds between the starts of the timeline's own windows; None (default) = half
+        their length.
     """
 
     metric: str = "hybrid"
@@ -144,6 +151,8 @@ class MapConfig:
     min_region_events: int = 50
     embed_dim: int = 3
     cycles: bool = True
+    timeline_length: float | None = None
+    timeline_step: float | None = None
 
     def __post_init__(self):
         for name in ("window_scales", "landmark_bands"):
@@ -192,6 +201,10 @@ class MapConfig:
                                   f"subsample {self.subsample!r} cannot, use maxmin")
         if self.window_step is not None and not (np.isfinite(self.window_step) and self.window_step > 0):
             bad("window_step", f"must be a positive number of seconds, got {self.window_step}")
+        if self.timeline_length is not None and not self.timeline_length > 0:
+            bad("timeline_length", f"must be a positive number of seconds, got {self.timeline_length}")
+        if self.timeline_step is not None and not (np.isfinite(self.timeline_step) and self.timeline_step > 0):
+            bad("timeline_step", f"must be a positive number of seconds, got {self.timeline_step}")
         if self.max_windows is not None and (isinstance(self.max_windows, bool) or
                                              not isinstance(self.max_windows, (int, np.integer)) or
                                              self.max_windows < len(scales)):
@@ -368,6 +381,8 @@ OPTIONS: dict[str, Option] = {option.name: option for option in (
     Option("max_landmarks", _integer(3, MAX_LANDMARKS)),
     Option("maxdim", _integer(1, 2)),
     Option("window", _span),
+    Option("timeline_length", _number(0.0, strict=True), _SECONDS),
+    Option("timeline_step", _number(0.0, strict=True), {"auto": None}),
     Option("seed", _integer(0)),
 )}
 """Every option users may set by name, with its parser."""

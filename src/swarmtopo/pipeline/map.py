@@ -10,6 +10,7 @@ The stages, in order (paper, "Algorithm Overview", and swarmtopo's windows)::
       landmarks, persistence                        metric.landmarks, topology.persistence
     per region: Betti numbers and confidence        readers (one reader.read call)
     per region: MDS picture, loops round the holes  topology.embed, topology.cycles
+    the timeline: sliding windows, change points    pipeline.timeline
     assemble the map                                pipeline.result
 
 Nothing here reads an arena, a truth file or simulator parameters: the map is a
@@ -34,17 +35,19 @@ from ..readers.registry import load_classifier, shipped_reader_for
 from ..topology.cycles import region_cycles
 from ..topology.embed import mds
 from ..topology.persistence import Diagram, rips_persistence
-from .config import MapConfig
+from .config import WHOLE_LOG, MapConfig
 from .engine import engine_for
 from .regions import MIN_REGION_AGENTS, split_regions
-from .result import RegionMap, RegionScales, TopologicalMap, WindowMap, software_versions
+from .result import RegionMap, RegionScales, TimelineWindow, TopologicalMap, WindowMap, software_versions
 from .settings import Settings, resolve
 from .tasks import AUTO_COVER_FACTOR, cut_window, describe_part, map_band, window_part
+from .timeline import (build_timeline, no_timeline_note, read_component, scaled_h1, split_window, timeline_settings,
+                       timeline_spans, timeline_window)
 from .windows import silence_warnings
 CALIBRATED_HOLES = 3
 """The most holes of any arena the confidence was calibrated on (the accuracy
 benchmark's cells: 0-3); a map counting more says its confidence is extrapolated."""
-STAGES = ("graph", "landmarks", "persistence", "classify", "embedding", "cycles")
+STAGES = ("graph", "landmarks", "persistence", "classify", "embedding", "cycles", "timeline")
 """Stage names passed to ``map_encounters``'s progress callback, in order."""
 
 
@@ -90,6 +93,11 @@ def map_encounters(
     config = (config or MapConfig()).validate()
     reader = reader or load_classifier(shipped_reader_for(log))
     settings = resolve(log, config, reader)
+    own_timeline = config.timeline_length is not None or config.timeline_step is not None
+    if own_timeline:  # a step too small for the log is refused before any map work
+        length, step = timeline_settings(config, settings.window_length[0])
+        if length != WHOLE_LOG:
+            timeline_spans(settings.times, length, step, config.min_region_events)
     rng = np.random.default_rng(config.seed)
     say = progress or (lambda stage: None)
     timings = dict.fromkeys(STAGES, 0.0)
@@ -106,12 +114,25 @@ def map_encounters(
     shares = (share_landmarks(config.landmarks, events_per_region) if config.landmarks
               else [None] * len(split.regions))
     with engine_for(workers, scheduler) as engine:
-        plans = _plan_windows(engine, chains, graph, split, log, config, settings, say)
+        shared_chains, shared_log = engine.share(chains), engine.share(log)
+        region_of_event = np.full(log.n_events, -1, np.int64)
+        for r, comp in enumerate(split.regions):
+            region_of_event[graph.event_index[split.event_comp == comp]] = r
+        shared_regions = engine.share(region_of_event)
+        plans, splits = _plan_windows(engine, shared_chains, shared_log, shared_regions, graph, split, config,
+                                      settings, say, timeline=not own_timeline)
         say("persistence")
         regions = []
         for comp, (plan, notes), n_land in zip(split.regions, plans, shares):
             windows = _map_region(engine, plan, n_land, config, rng, timings)
             regions.append(_read_region(comp, split, windows, notes, reader, config, rng, timings, say))
+        say("timeline")
+        t0 = time.perf_counter()
+        # one draw after all the map's others: the rest of the map is the same with or without it
+        timeline_windows, length, step = _map_timeline(engine, shared_chains, shared_log, shared_regions, splits,
+                                                       regions, shares, config, settings, reader,
+                                                       int(rng.integers(2**63)))
+        timings["timeline"] = time.perf_counter() - t0
 
     betti: dict[int, int | None] = {0: len(regions)}
     confidence: dict[int, float | None] = {0: shipped_beta0_model().confidence(split.beta0)}
@@ -119,6 +140,8 @@ def map_encounters(
         known = all(n in r.betti for r in regions)
         betti[n] = sum(r.betti[n] for r in regions) if known else None
         confidence[n] = reader.map_confidence([r.confidence.get(n) for r in regions], n) if known else None
+    timeline = build_timeline(timeline_windows, length, step, betti, confidence, log,
+                              note=None if timeline_windows else no_timeline_note(config, length))
     return TopologicalMap(
         betti=betti,
         confidence=confidence,
@@ -135,22 +158,28 @@ def map_encounters(
         diffusion_time=settings.diffusion_time,
         window_length=settings.window_length,
         windows_left_out=settings.windows_left_out,
-        log_warnings=silence_warnings(settings.times, settings.window_length[0]) + _extrapolation_warnings(betti),
+        log_warnings=(silence_warnings(settings.times, settings.window_length[0]) + _extrapolation_warnings(betti)
+                      + _change_warnings(timeline)),
         beta0_evidence=split.beta0,
         contact_trace=len(log.status_t) == 0,
         software=software_versions(),
+        timeline=timeline,
     )
 
 
-def _plan_windows(engine, chains, graph, split, log, config: MapConfig, settings: Settings,
-                  say) -> list[tuple[list, list[str]]]:
+def _plan_windows(engine, shared_chains, shared_log, shared_regions, graph, split, config: MapConfig,
+                  settings: Settings, say, timeline: bool) -> tuple[list[tuple[list, list[str]]], list]:
     """Per region: the (part, span, PartInfo) of every window that holds enough of it (its
     whole log instead when none does), the parts left on the engine, and notes on what
-    was skipped.  Every window's graph is cut once and shared by the regions."""
+    was skipped; and (``timeline``) each window's split into regions, a task
+    (:func:`.timeline.split_window`).  Every window's graph is cut once and shared by the
+    regions and the split."""
     say("landmarks")
     bands = settings.landmark_bands
-    shared_chains, shared_log = engine.share(chains), engine.share(log)
     cuts = [engine.submit(cut_window, shared_chains, span) for span in settings.spans]
+    splits = [engine.submit(split_window, cut, shared_regions, shared_log, config.min_region_events,
+                            settings.agent_gap) if timeline and span is not None else None
+              for cut, span in zip(cuts, settings.spans)]
     parts, infos = [], []
     for comp in split.regions:
         region_events = engine.share(graph.event_index[split.event_comp == comp])
@@ -177,7 +206,60 @@ def _plan_windows(engine, chains, graph, split, log, config: MapConfig, settings
                          f"of their time span a landmark band draws from (a quiet stretch of the log): {quiet}; "
                          f"they were mapped without that band")
         plans.append((plan, notes))
-    return plans
+    return plans, splits
+
+
+def _map_timeline(engine, shared_chains, shared_log, shared_regions, splits: list, regions: list[RegionMap],
+                  shares, config: MapConfig, settings: Settings, reader: BettiReader,
+                  entropy: int) -> tuple[list[TimelineWindow], float, float]:
+    """The timeline's windows (:mod:`.timeline`), read: the map's own windows, each
+    region part the map mapped read again on its own and any other component of a
+    window (a region that split) mapped as a task; or, with ``timeline_length`` or
+    ``timeline_step`` set, windows of their own, every component mapped as a task.
+    Returns (windows, their length, step)."""
+    length, step = timeline_settings(config, settings.window_length[0])
+    if splits and any(s is not None for s in splits):  # the map's windows
+        spans, step = settings.spans, config.window_step
+        mapped: dict[tuple, list[WindowMap]] = {}
+        for r, region in enumerate(regions):
+            for w in region.windows:
+                mapped.setdefault((r, (w.t0, w.t1)), []).append(w)
+    else:  # windows of the timeline's own length and step
+        spans = [] if length == WHOLE_LOG else timeline_spans(settings.times, length, step, config.min_region_events)
+        splits = [engine.submit(split_window, engine.submit(cut_window, shared_chains, span), shared_regions,
+                                shared_log, config.min_region_events, settings.agent_gap) for span in spans]
+        mapped = {}
+    step = length / 2 if step is None else step
+    if not spans:
+        return [], length, step
+    kept = [(span, split) for span, split in zip(spans, splits) if split is not None]
+    pairs = [(span, split) for (span, _), split in zip(kept, engine.gather([split for _, split in kept]))
+             if split is not None]
+    shared_reader = engine.share(reader)
+    readings, tasks = [], []
+    for k, (span, split) in enumerate(pairs):
+        for j, (label, region, own, _) in enumerate(split.components):
+            windows = mapped.get((region, span)) if own else None
+            if windows:
+                readings.append((reader.read([w.diagram for w in windows], [w.n_events for w in windows]),
+                                 scaled_h1(windows[0])))
+            else:
+                n_land = None if not config.landmarks else int(shares[max(region, 0)])
+                readings.append(None)
+                tasks.append((len(readings) - 1, engine.submit(read_component, shared_chains, span, label, n_land,
+                                                               config, settings.landmark_bands, shared_reader,
+                                                               entropy, k * 1_000 + j)))
+    for (i, _), result in zip(tasks, engine.gather([t for _, t in tasks])):
+        readings[i] = result
+    out, at = [], 0
+    for span, split in pairs:
+        mine = readings[at:at + len(split.components)]
+        at += len(split.components)
+        events = int(np.searchsorted(settings.times, span[1], side="right")
+                     - np.searchsorted(settings.times, span[0], side="left"))
+        out.append(timeline_window(span, events, split, mine, reader, config.maxdim))
+    out.sort(key=lambda w: (w.t0 + w.t1, w.t1 - w.t0))
+    return out, length, step
 
 
 def _map_region(engine, plan, n_land: int | None, config: MapConfig, rng, timings) -> list[WindowMap]:
@@ -264,6 +346,14 @@ def _extrapolation_warnings(betti: dict[int, int | None]) -> list[str]:
                 "calibrated on (docs/accuracy.md): the confidence is extrapolated, and many holes in one arena "
                 "leave narrow passages between them, where holes merge or go unseen"]
     return []
+
+
+def _change_warnings(timeline) -> list[str]:
+    """The arena changed during the log: the pooled Betti numbers mix before and after."""
+    if not timeline.changes:
+        return []
+    return [f"the Betti numbers changed during the log ({timeline.summary()}): the pooled answer mixes the "
+            "arena before and after; read the timeline's segments (map.json 'timeline', docs/timeline.md)"]
 
 
 def _sampling_warnings(scales: RegionScales, n_landmarks: int, config: MapConfig) -> list[str]:

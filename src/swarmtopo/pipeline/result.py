@@ -80,6 +80,91 @@ class RegionMap:
     window: int  # index of the representative window
 
 
+@dataclass
+class TimelineWindow:
+    """One sliding window [t0, t1]: its Betti numbers, their confidence, and its
+    longest H1 bars divided by its regions' median H1 bar length (scale-free, for the
+    CROCKER picture)."""
+
+    t0: float
+    t1: float
+    n_events: int
+    betti: dict[int, int]
+    confidence: dict[int, float | None]
+    h1_scaled: np.ndarray = field(default_factory=lambda: np.empty(0))
+    region_agents: list[np.ndarray] = field(default_factory=list)  # the agents of each of its regions
+
+    @property
+    def t(self) -> float:
+        """The window's middle."""
+        return (self.t0 + self.t1) / 2
+
+
+@dataclass(frozen=True)
+class Segment:
+    """A stretch of time over which dimension ``dim``'s count is ``value``."""
+
+    dim: int
+    value: int
+    t_from: float
+    t_until: float
+    confidence: float | None
+    windows: int  # timeline windows in it
+
+
+@dataclass(frozen=True)
+class ChangePoint:
+    """beta_dim changes from ``before`` to ``after`` at about ``t``, within [lo, hi]."""
+
+    dim: int
+    t: float
+    before: int
+    after: int
+    lo: float
+    hi: float
+    confidence: float | None
+
+
+@dataclass
+class Timeline:
+    """The map's Betti numbers over time (module docstring)."""
+
+    length: float
+    step: float
+    windows: list[TimelineWindow]
+    segments: dict[int, list[Segment]]
+    changes: list[ChangePoint]
+    note: str | None = None  # why there are no windows, when there are none
+
+    def table(self) -> dict[str, np.ndarray]:
+        """The windows as columns (``pandas.DataFrame(timeline.table())``): t0, t1, t,
+        n_events, beta_n and confidence_n per dimension."""
+        dims = sorted({n for w in self.windows for n in w.betti} | set(self.segments))
+        cols: dict[str, np.ndarray] = {
+            "t0": np.array([w.t0 for w in self.windows]), "t1": np.array([w.t1 for w in self.windows]),
+            "t": np.array([w.t for w in self.windows]),
+            "n_events": np.array([w.n_events for w in self.windows], dtype=np.int64)}
+        for n in dims:
+            cols[f"beta_{n}"] = np.array([w.betti.get(n, -1) for w in self.windows], dtype=np.int64)
+            cols[f"confidence_{n}"] = np.array([np.nan if w.confidence.get(n) is None else w.confidence[n]
+                                                for w in self.windows])
+        return cols
+
+    def summary(self) -> str:
+        """One line: "no change ..." or, per changing dimension, "beta_1 = 1 until about 140 s, then 2"."""
+        if not self.changes:
+            span = f" over {self.windows[0].t0:.4g}-{self.windows[-1].t1:.4g} s" if self.windows else ""
+            return f"no change of the Betti numbers{span} ({len(self.windows)} time windows)"
+        parts = []
+        for n in sorted({c.dim for c in self.changes}):
+            segs = self.segments[n]
+            text = f"beta_{n} = {segs[0].value}"
+            for seg, change in zip(segs[1:], [c for c in self.changes if c.dim == n]):
+                text += f" until about {change.t:.0f} s, then {seg.value}"
+            parts.append(text)
+        return "; ".join(parts)
+
+
 @dataclass(eq=False)
 class TopologicalMap:
     """The result of mapping an encounter log.
@@ -110,6 +195,7 @@ class TopologicalMap:
     log_warnings: list[str] = field(default_factory=list)  # about the mapped log as a whole
     beta0_evidence: Beta0Evidence | None = None  # what beta_0's confidence was read from
     contact_trace: bool = False  # the log has no status changes: a contact trace
+    timeline: Timeline | None = None  # Betti numbers over sliding windows, change points (pipeline.timeline)
 
     @property
     def warnings(self) -> list[str]:

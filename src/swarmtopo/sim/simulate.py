@@ -30,9 +30,11 @@ from numba.core.registry import CPUDispatcher
 from .. import __version__
 from .._validate import fraction, non_negative, positive, positive_int
 from ..arena import Arena
+from ..changing import ChangingArena
 from ..errors import InputError
 from .._json import jsonable
 from ..log import LOG_FORMAT, EncounterLog, state_labels
+from . import changes as _changes
 from . import commands as _commands
 from . import motion as _motion
 from . import sensing as _sensing
@@ -97,8 +99,11 @@ def simulate(
 
     Parameters
     ----------
-    arena : Arena
-        Free space (mm).
+    arena : Arena or ChangingArena
+        Free space (mm).  A changing arena's obstacles appear and go at the first
+        step t_k at or after their times, before that step's sensing: the walls are
+        rebuilt, every agent inside a present obstacle moves to the nearest free point,
+        and a wall follower whose wall is gone walks on (:mod:`.changes`).
     n_agents : int
         Swarm size N >= 1.
     duration : float
@@ -152,9 +157,11 @@ def simulate(
     n_steps = _n_steps(duration, dt)
     r_d = sensing.r_d
     max_step = max(motion.v_c, motion.v_p) * dt
-    walls = _walls.build_wall_grid(arena.boundary_segments, arena.bounds, cell=r_d, reach=r_d + 3 * max_step)
+    reach = r_d + 3 * max_step
+    free = arena.at(0.0) if isinstance(arena, ChangingArena) else arena
+    walls = _walls.build_wall_grid(free.boundary_segments, free.bounds, cell=r_d, reach=reach)
     model = _motion.make_model(motion, r_d, dt)
-    agents = _motion.new_swarm(arena.sample_uniform(n, gen, clearance=_walls.WALL_EPS), model, gen)
+    agents = _motion.new_swarm(free.sample_uniform(n, gen, clearance=_walls.WALL_EPS), model, gen)
     tracker = _sensing.EncounterTracker(n, r_d, walls if sensing.walls_block else None,
                                         log_initial_contacts=sensing.log_initial_contacts)
     sample_every = None if trajectory_every is None else max(1, int(round(trajectory_every / dt)))
@@ -167,8 +174,19 @@ def simulate(
     samples: list[tuple] = []
     changed = np.empty(n, np.int64)
     next_command = 0
+    changes = arena.change_times() if isinstance(arena, ChangingArena) else []
+    relocated: list[dict] = []
     for k in range(n_steps + 1):
         t = round(k * dt, TIME_DECIMALS)
+        if changes and round(changes[0], TIME_DECIMALS) <= t:  # the arena changes before anyone senses
+            while changes and round(changes[0], TIME_DECIMALS) <= t:
+                latest = changes.pop(0)
+            free = arena.at(max(t, latest))  # a change just after t_k (within rounding) is applied at t_k
+            walls = _walls.build_wall_grid(free.boundary_segments, free.bounds, cell=r_d, reach=reach)
+            if sensing.walls_block:
+                tracker.walls = walls
+            moved = _changes.arena_changed(agents, free, walls, model)
+            relocated.append({"t": t, "agents": moved})
         x, y = np.ascontiguousarray(agents["x"]), np.ascontiguousarray(agents["y"])
         a, b = tracker.update(t, x, y)
         if len(a):
@@ -192,6 +210,9 @@ def simulate(
             progress((k + 1) / (n_steps + 1))
 
     meta = _meta(arena, n, n_steps, dt, motion, sensing, commands, static_fraction, static_time, seed)
+    if isinstance(arena, ChangingArena):
+        meta["simulation"]["betti_timeline"] = jsonable(arena.betti_timeline(meta["duration"]))
+        meta["simulation"]["relocated"] = relocated
     log, order = _build_log(events, status, static_agents, static_times, meta)
     return Simulation(
         log=log,
@@ -203,8 +224,8 @@ def simulate(
 
 def _check_inputs(arena, n_agents, duration, dt, motion, sensing, commands, static_fraction, static_time,
                   trajectory_every, progress) -> None:
-    if not isinstance(arena, Arena):
-        raise InputError(f"arena must be a swarmtopo Arena, got {type(arena).__name__}")
+    if not isinstance(arena, (Arena, ChangingArena)):
+        raise InputError(f"arena must be a swarmtopo Arena or ChangingArena, got {type(arena).__name__}")
     check_parameters(n_agents, duration, dt=dt, motion=motion, sensing=sensing, commands=commands,
                      static_fraction=static_fraction, static_time=static_time)
     if trajectory_every is not None:

@@ -27,13 +27,22 @@ def write_map(tmap: TopologicalMap, out_dir: Path, *, log: EncounterLog,
     """Write map.json, report.html, diagram.png and (with an MDS picture) cloud.png; return the paths.
 
     ``trajectories`` (``io.read_trajectories``) adds the swarm animation to the report.
+    A :class:`~swarmtopo.changing.ChangingArena` is drawn as it is at the log's last
+    event, and the report's timeline shows its true Betti numbers over time.
     """
+    from ..changing import ChangingArena, betti_timeline_of
+
+    true_timeline = None
+    if isinstance(arena, ChangingArena):  # pictures draw the arena at the log's end; the verdict its timeline
+        true_timeline = betti_timeline_of(arena, float(log.t.max()) if log.n_events else 0.0)
+        arena = arena.at(float(log.t.max()) if log.n_events else 0.0)
     out_dir = Path(out_dir)
     make_folder(out_dir)
     written = [out_dir / "map.json", out_dir / "report.html", out_dir / "diagram.png"]
     doc = map_json(tmap)  # one document for map.json and the report: they cannot disagree
     write_json(doc, written[0])
-    write_report(tmap, written[1], log=log, truth=truth, arena=arena, trajectories=trajectories, doc=doc)
+    write_report(tmap, written[1], log=log, truth=truth, arena=arena, trajectories=trajectories, doc=doc,
+                 true_timeline=true_timeline)
     _diagram_figure(tmap).savefig(written[2], dpi=110)
     if any(r.embedding is not None for r in tmap.regions):
         written.append(out_dir / "cloud.png")

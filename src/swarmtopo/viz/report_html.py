@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..changing import timeline_text
 from ..topology.cycles import encircled_obstacles, event_positions
 from ..log import STATES, EncounterLog
 from ..pipeline.result import TopologicalMap
@@ -62,16 +63,16 @@ code{background:#f5f5f5;padding:0 .2em}
 
 
 def write_report(tmap: TopologicalMap, path, *, log: EncounterLog, truth: dict | None = None, arena=None,
-                 trajectories: dict | None = None, doc: dict | None = None) -> Path:
+                 trajectories: dict | None = None, doc: dict | None = None, true_timeline: list | None = None) -> Path:
     """Write :func:`report_html` to ``path`` (UTF-8) and return the path."""
     path = Path(path)
-    path.write_text(report_html(tmap, log=log, truth=truth, arena=arena, trajectories=trajectories, doc=doc),
-                    encoding="utf-8")
+    path.write_text(report_html(tmap, log=log, truth=truth, arena=arena, trajectories=trajectories, doc=doc,
+                                true_timeline=true_timeline), encoding="utf-8")
     return path
 
 
 def report_html(tmap: TopologicalMap, *, log: EncounterLog, truth: dict | None = None, arena=None,
-                trajectories: dict | None = None, doc: dict | None = None) -> str:
+                trajectories: dict | None = None, doc: dict | None = None, true_timeline: list | None = None) -> str:
     """The report as one HTML document (see the module docstring).
 
     Parameters
@@ -89,13 +90,18 @@ def report_html(tmap: TopologicalMap, *, log: EncounterLog, truth: dict | None =
         Sampled true positions (``io.read_trajectories``): the swarm animation.
     doc
         ``viz.summary.map_json(tmap)`` when the caller already has it (the map.json it writes).
+    true_timeline
+        The true Betti numbers over time of an arena that changed
+        (:func:`swarmtopo.changing.betti_timeline_of`): drawn on the timeline, and the
+        verdict gives them instead of comparing the pooled answer with one arena.
     """
     from plotly.offline import get_plotlyjs
 
     doc = doc or map_json(tmap)
     figures: dict[str, dict] = {}
     sections = [
-        _verdict_section(doc, arena),
+        _verdict_section(doc, None if true_timeline else arena, true_timeline),
+        _timeline_section(doc, figures, true_timeline),
         _persistence_section(tmap, doc, figures),
         _cloud_section(tmap, log, truth, arena, figures),
     ]
@@ -153,9 +159,10 @@ def script_json(obj) -> str:
 
 
 # -- sections ------------------------------------------------------------------------------
-def _verdict_section(doc: dict, arena) -> str:
+def _verdict_section(doc: dict, arena, true_timeline: list | None = None) -> str:
     true_betti = dict(enumerate(arena.betti)) if arena is not None else {}
     items = []
+    timeline = doc.get("timeline") or {}
     for key, value in doc["betti"].items():
         n = int(key)
         conf = doc["confidence"].get(key)
@@ -166,6 +173,11 @@ def _verdict_section(doc: dict, arena) -> str:
         items.append(f'<span class="betti" data-dim="{n}" data-value="{shown}">&beta;<sub>{n}</sub> = {shown}</span>'
                      f" ({conf_html})")
     lines = [f'<p class="betti-line">{" &nbsp;&middot;&nbsp; ".join(items)}</p>']
+    if timeline.get("changes"):
+        lines.insert(0, f'<p class="changed">the arena changed: {html.escape(timeline["summary"])} '
+                        '(<a href="#timeline">timeline</a>); pooled over the whole log:</p>')
+    if true_timeline:
+        lines.append(f'<p class="truth">true (from the arena): {html.escape(timeline_text(true_timeline))}</p>')
     if true_betti:
         agree = all(doc["betti"].get(str(n)) == b for n, b in true_betti.items())
         truth_items = ", ".join(f'<span class="true-betti" data-dim="{n}" data-value="{b}">&beta;<sub>{n}</sub> = {b}'
@@ -185,6 +197,94 @@ def _verdict_section(doc: dict, arena) -> str:
     if len(doc["regions"]) > 1:
         lines.append(_regions_table(doc))
     return f'<section id="verdict"><h2>Verdict</h2>\n{"".join(lines)}</section>\n'
+
+
+def _timeline_section(doc: dict, figures: dict, true_timeline: list | None) -> str:
+    timeline = doc.get("timeline")
+    if not timeline or not timeline["windows"]:
+        note = (timeline or {}).get("note") or "no timeline"
+        return f'<section id="timeline"><h2>Timeline</h2><p class="note">{html.escape(note)}</p></section>\n'
+    figures["plot-timeline"] = _timeline_figure(timeline, true_timeline)
+    rows = "".join(
+        f'<tr class="change" data-dim="{c["dimension"]}" data-t="{c["t"]!r}"><td>&beta;<sub>{c["dimension"]}</sub></td>'
+        f'<td class="num">{c["from"]} &rarr; {c["to"]}</td><td class="num">{c["t"]:.0f} s</td>'
+        f'<td class="num">{c["interval"][0]:.0f}&ndash;{c["interval"][1]:.0f} s</td>'
+        f'<td class="num">{"&ndash;" if c["confidence"] is None else format_confidence(c["confidence"])}</td></tr>'
+        for c in timeline["changes"])
+    table = ("<table><tr><th>dimension</th><th>change</th><th>at about</th><th>within</th><th>confidence</th></tr>"
+             f"{rows}</table>" if rows else "")
+    return ('<section id="timeline"><h2>Timeline</h2>\n'
+            f'<p class="timeline-summary">{html.escape(timeline["summary"])}</p>{table}'
+            f'<p class="note">Top: the Betti numbers of each time window ({_lengths(timeline["windows"])} long) at its '
+            "middle; the band around each is 1 &minus; its confidence wide on either "
+            "side (thin: sure); thick lines are the segments, shaded bars the change points' intervals"
+            f'{", dashed lines the true numbers" if true_timeline else ""}. Bottom (a CROCKER plot): for each window, '
+            "how many H1 bars are longer than a multiple of the window's median H1 bar (its typical noise loop): "
+            "the holes are the bands that run high along time; a hole that appears starts a new band.</p>"
+            '<div id="plot-timeline" class="plot" style="height:640px"></div></section>\n')
+
+
+def _lengths(windows: list[dict]) -> str:
+    """The range of the windows' lengths, e.g. "12.6-21 s"."""
+    lengths = [w["t1"] - w["t0"] for w in windows]
+    lo, hi = min(lengths), max(lengths)
+    return f"{lo:.3g} s" if f"{lo:.3g}" == f"{hi:.3g}" else f"{lo:.3g}-{hi:.3g} s"
+
+
+def _timeline_figure(timeline: dict, true_timeline: list | None) -> dict:
+    """Betti numbers per window with their confidence band, segments and change points
+    (top); the windows' H1 bar counts over scale-free lengths, a CROCKER plot (bottom)."""
+    windows = timeline["windows"]
+    t = _floats([(w["t0"] + w["t1"]) / 2 for w in windows], 4)
+    colors = {"0": "#1f77b4", "1": "#d62728", "2": "#2ca02c"}
+    traces, shapes = [], []
+    for n in sorted({n for w in windows for n in w["betti"]}):
+        windows_n = [w for w in windows if n in w["betti"]]
+        t_n = _floats([(w["t0"] + w["t1"]) / 2 for w in windows_n], 4)
+        values = [w["betti"][n] for w in windows_n]
+        width = [1 - (w["confidence"].get(n) if w["confidence"].get(n) is not None else 0.5) for w in windows_n]
+        upper = [v + d for v, d in zip(values, width)]
+        lower = [v - d for v, d in zip(values, width)]
+        color = colors.get(n, "#555555")
+        traces.append({"type": "scatter", "x": t_n + t_n[::-1], "y": _floats(upper + lower[::-1], 4), "fill": "toself",
+                       "fillcolor": color, "opacity": 0.18, "line": {"width": 0}, "hoverinfo": "skip",
+                       "showlegend": False, "xaxis": "x", "yaxis": "y"})
+        traces.append({"type": "scatter", "mode": "markers", "x": t_n, "y": values, "name": f"beta_{n} per window",
+                       "marker": {"color": color, "size": 7},
+                       "text": [f"{w['t0']:.1f}-{w['t1']:.1f} s, confidence "
+                                f"{'none' if w['confidence'].get(n) is None else format_confidence(w['confidence'][n])}"
+                                for w in windows_n], "xaxis": "x", "yaxis": "y"})
+        for seg in timeline["segments"].get(n, []):
+            traces.append({"type": "scatter", "mode": "lines", "x": _floats([seg["from"], seg["until"]], 4),
+                           "y": [seg["value"], seg["value"]], "line": {"color": color, "width": 4},
+                           "name": f"beta_{n} segment", "showlegend": False, "xaxis": "x", "yaxis": "y",
+                           "hoverinfo": "skip"})
+        if true_timeline and all(f"beta_{n}" in interval for interval in true_timeline):
+            xs, ys = [], []
+            for interval in true_timeline:
+                xs += [interval["from"], interval["until"]]
+                ys += [interval[f"beta_{n}"]] * 2
+            traces.append({"type": "scatter", "mode": "lines", "x": _floats(xs, 4), "y": ys,
+                           "line": {"color": color, "dash": "dash", "width": 1.5}, "name": f"true beta_{n}",
+                           "xaxis": "x", "yaxis": "y"})
+    for c in timeline["changes"]:
+        shapes.append({"type": "rect", "xref": "x", "yref": "paper", "x0": c["interval"][0], "x1": c["interval"][1],
+                       "y0": 0.5, "y1": 1, "fillcolor": "#ffbf00", "opacity": 0.2, "line": {"width": 0}})
+        shapes.append({"type": "line", "xref": "x", "yref": "paper", "x0": c["t"], "x1": c["t"], "y0": 0, "y1": 1,
+                       "line": {"color": "#b07800", "width": 2}})
+    longest = max([max(w["h1_scaled_lengths"], default=0) for w in windows] + [1.0])
+    levels = np.geomspace(1.0, max(longest, 1.01), 60)
+    z = [[int(np.sum(np.asarray(w["h1_scaled_lengths"]) > level)) for w in windows] for level in levels]
+    traces.append({"type": "heatmap", "x": t, "y": _floats(levels, 4), "z": z, "colorscale": "Viridis",
+                   "colorbar": {"title": {"text": "H1 bars"}, "len": 0.4, "y": 0.2}, "xaxis": "x2", "yaxis": "y2",
+                   "hovertemplate": "t %{x:.1f} s, length / median > %{y:.3g}: %{z} bars<extra></extra>"})
+    return {"data": traces, "layout": {
+        "height": 640, "margin": {"t": 20, "l": 60, "r": 20, "b": 50}, "shapes": shapes,
+        "legend": {"orientation": "h", "y": 1.08},
+        "xaxis": {"anchor": "y", "domain": [0, 1], "matches": "x2", "showticklabels": False},
+        "yaxis": {"domain": [0.5, 1], "title": {"text": "Betti number"}, "dtick": 1, "rangemode": "tozero"},
+        "xaxis2": {"anchor": "y2", "domain": [0, 1], "title": {"text": "time (s)"}},
+        "yaxis2": {"domain": [0, 0.42], "type": "log", "title": {"text": "H1 bar length / median"}}}}
 
 
 def _regions_table(doc: dict) -> str:

@@ -6,13 +6,14 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict
 from typing import Any
 
 import numpy as np
 
 from .._json import jsonable
-from ..pipeline.result import RegionMap, TopologicalMap, WindowMap
+from ..pipeline.result import RegionMap, Timeline, TopologicalMap, WindowMap
 from ..readers.beta0 import BETA0_DEFINITION
 from ..readers.ratio import RESOLUTION_CAP, below_full_resolution, resolution
 from .text import format_confidence
@@ -68,6 +69,7 @@ def map_json(tmap: TopologicalMap) -> dict[str, Any]:
         "advice": advice(tmap),
         "regions": [_region_json(r) for r in tmap.regions],
         "too_little_data": tmap.too_little_data,
+        "timeline": None if tmap.timeline is None else timeline_json(tmap.timeline),
         "beta0_evidence": None if tmap.beta0_evidence is None else {**tmap.beta0_evidence.to_json(),
                                                                       "definition": BETA0_DEFINITION},
         "params": {**jsonable(asdict(tmap.config)), "hop_cost_used": tmap.hop_cost[0],
@@ -79,6 +81,25 @@ def map_json(tmap: TopologicalMap) -> dict[str, Any]:
         "log": {"events": tmap.n_events, "agents": tmap.n_agents, "contact_trace": tmap.contact_trace},
         "timings": {k: round(v, 6) for k, v in tmap.timings.items()},
         "software": {**tmap.software, "persistence_backend": tmap.diagram.backend},
+    }
+
+
+def timeline_json(timeline: Timeline) -> dict[str, Any]:
+    """map.json's ``timeline`` (an unknown or infinite number as null)."""
+    def number(p):
+        return None if p is None or not math.isfinite(p) else float(p)
+    return {
+        "length": number(timeline.length), "step": number(timeline.step), "note": timeline.note,
+        "summary": timeline.summary(),
+        "windows": [{"t0": w.t0, "t1": w.t1, "events": w.n_events,
+                     "betti": {str(n): b for n, b in sorted(w.betti.items())},
+                     "confidence": {str(n): number(p) for n, p in sorted(w.confidence.items())},
+                     "h1_scaled_lengths": [float(x) for x in w.h1_scaled]} for w in timeline.windows],
+        "segments": {str(n): [{"value": s.value, "from": number(s.t_from), "until": number(s.t_until),
+                               "confidence": number(s.confidence), "windows": s.windows} for s in segs]
+                     for n, segs in sorted(timeline.segments.items())},
+        "changes": [{"dimension": c.dim, "t": c.t, "from": c.before, "to": c.after, "interval": [c.lo, c.hi],
+                     "confidence": number(c.confidence)} for c in timeline.changes],
     }
 
 
