@@ -24,7 +24,6 @@ store like any sweep, and each job maps a log folder stripped of ground truth
 
 from __future__ import annotations
 
-import hashlib
 import json
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -40,8 +39,8 @@ from ..errors import SwarmtopoError
 from ..readers.paper import published_paper_classifier
 from ..readers.registry import load_classifier
 from ..pipeline import MapConfig
-from .grid import Job, canonical_json, case_streams
-from .sweep import build_arena
+from .grid import Job, canonical_json, case_streams, suite_case_seed
+from .sweep import build_arena, first_placeable
 
 SUITE = "swarmtopo-accuracy/1"
 BUDGETS: tuple[tuple[int, float], ...] = ((200, 30.0), (300, 40.0), (400, 60.0))
@@ -124,9 +123,7 @@ def tuning_session():
 
 def case_seed(cell: Cell, split: str, index: int, attempt: int = 0) -> int:
     """64-bit seed of one case, from (SUITE, cell, split, index, attempt)."""
-    identity = {"suite": SUITE, "cell": cell.name, "split": split, "index": index}
-    text = canonical_json(identity if attempt == 0 else {**identity, "attempt": attempt})
-    return int.from_bytes(hashlib.sha256(text.encode()).digest()[:8], "big")
+    return suite_case_seed(SUITE, cell.name, split, index, attempt)
 
 
 def case_arena(cell: Cell, split: str, index: int, attempt: int = 0) -> dict[str, Any]:
@@ -150,15 +147,9 @@ def case(cell: Cell, split: str, index: int) -> tuple[dict[str, Any], int]:
     draw is replaced by the next attempt's, decided once by building the arena, so
     every case of the suite is a valid arena.  Cached: building arenas is the slow part.
     """
-    for attempt in range(MAX_ATTEMPTS):
-        arena = case_arena(cell, split, index, attempt)
-        seed = case_seed(cell, split, index, attempt)
-        try:
-            build_arena(arena, case_streams(seed)["arena"])
-        except SwarmtopoError:
-            continue
-        return arena, seed
-    raise SwarmtopoError(f"{SUITE}: no placeable arena for {cell.name} case {index} in {MAX_ATTEMPTS} attempts")
+    return first_placeable(lambda attempt: (case_arena(cell, split, index, attempt),
+                                            case_seed(cell, split, index, attempt)),
+                           MAX_ATTEMPTS, f"{SUITE}: {cell.name} case {index}")
 
 
 def built_case(cell: Cell, split: str, index: int):

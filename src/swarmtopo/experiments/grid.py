@@ -303,6 +303,15 @@ class Job:
         return hashlib.sha256(canonical_json(identity).encode()).digest()
 
 
+def suite_case_seed(suite: str, cell: str, split: str, index: int, attempt: int = 0) -> int:
+    """64-bit seed of case ``index`` of a benchmark suite's cell in one split (tuning,
+    reporting, ...), from the SHA-256 of (suite, cell, split, index, attempt): splits never
+    share a seed and adding cases never changes old ones."""
+    identity = {"suite": suite, "cell": cell, "split": split, "index": index}
+    text = canonical_json(identity if attempt == 0 else {**identity, "attempt": attempt})
+    return int.from_bytes(hashlib.sha256(text.encode()).digest()[:8], "big")
+
+
 def case_streams(case_seed: int) -> dict[str, int]:
     """The arena and simulation seeds of a shared case (``Job.case_seed``)."""
     children = np.random.SeedSequence(case_seed).spawn(2)

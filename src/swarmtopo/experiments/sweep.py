@@ -47,7 +47,8 @@ from ..pipeline.engine import POLL_SECONDS, connected_client, deferred_interrupt
 from ..pipeline.result import software_versions
 from ..viz.summary import timeline_json, window_json
 from ..sim import simulate
-from .grid import DEFAULT_JOB_TIMEOUT, KEEP_LEVELS, Job, flat_columns, job_map_config, job_simulation_args
+from .grid import (DEFAULT_JOB_TIMEOUT, KEEP_LEVELS, Job, case_streams, flat_columns, job_map_config,
+                   job_simulation_args)
 from .isolation import JobProcess, one_line
 from .store import JOB_COLUMNS, LOCK_WAIT, FailureGroup, ResultStore, encode_regions, group_failures, utcnow
 
@@ -84,6 +85,21 @@ def build_arena(arena: dict[str, Any], rng, path: str | None = None) -> Arena | 
     else:
         base = read_arena(path)
     return base if scale == 1.0 else base.scaled(scale)
+
+
+def first_placeable(draw: Callable[[int], tuple[dict[str, Any], int]], attempts: int, what: str
+                    ) -> tuple[dict[str, Any], int]:
+    """The first of ``draw(attempt)`` = (config with an ``arena`` table or an arena table, seed)
+    whose arena can be built (some draws cannot hold their holes: three walls in a narrow
+    rectangle), attempt 0, 1, ... up to ``attempts``."""
+    for attempt in range(attempts):
+        config, seed = draw(attempt)
+        try:
+            build_arena(config.get("arena", config), case_streams(seed)["arena"])
+        except SwarmtopoError:
+            continue
+        return config, seed
+    raise SwarmtopoError(f"no placeable arena for {what} in {attempts} attempts")
 
 
 def stripped_log(log: EncounterLog) -> EncounterLog:

@@ -22,18 +22,16 @@ static control with any change point is a false alarm.
 
 from __future__ import annotations
 
-import hashlib
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ..arena import HOLE_SHAPES, OUTER_SHAPES
-from ..errors import SwarmtopoError
 from ..topology.cycles import wilson_interval
 from .accuracy import PIPELINES
-from .grid import Job, canonical_json, case_streams
-from .sweep import build_arena
+from .grid import Job, canonical_json, suite_case_seed
+from .sweep import first_placeable
 
 SUITE = "swarmtopo-timeline/1"
 KINDS = ("appear", "disappear", "door", "none")
@@ -70,9 +68,7 @@ CELLS: tuple[Cell, ...] = tuple(Cell(kind, n) for kind in KINDS for n in AGENTS)
 
 def case_seed(cell: Cell, split: str, index: int, attempt: int = 0) -> int:
     """64-bit seed of one case, from (SUITE, cell, split, index, attempt)."""
-    identity = {"suite": SUITE, "cell": cell.name, "split": split, "index": index}
-    text = canonical_json(identity if attempt == 0 else {**identity, "attempt": attempt})
-    return int.from_bytes(hashlib.sha256(text.encode()).digest()[:8], "big")
+    return suite_case_seed(SUITE, cell.name, split, index, attempt)
 
 
 def case_config(cell: Cell, split: str, index: int, attempt: int = 0) -> dict[str, Any]:
@@ -94,15 +90,9 @@ def case_config(cell: Cell, split: str, index: int, attempt: int = 0) -> dict[st
 def case(cell: Cell, split: str, index: int) -> tuple[dict[str, Any], int]:
     """(config tables, case seed) of a case whose arena can be built (the next attempt's
     draw replaces one whose holes do not fit)."""
-    for attempt in range(MAX_ATTEMPTS):
-        config = case_config(cell, split, index, attempt)
-        seed = case_seed(cell, split, index, attempt)
-        try:
-            build_arena(config["arena"], case_streams(seed)["arena"])
-        except SwarmtopoError:
-            continue
-        return config, seed
-    raise SwarmtopoError(f"{SUITE}: no placeable arena for {cell.name} case {index} in {MAX_ATTEMPTS} attempts")
+    return first_placeable(lambda attempt: (case_config(cell, split, index, attempt),
+                                            case_seed(cell, split, index, attempt)),
+                           MAX_ATTEMPTS, f"{SUITE}: {cell.name} case {index}")
 
 
 def jobs(split: str, per_cell: int, cells=CELLS) -> list[Job]:
