@@ -184,7 +184,7 @@ def test_real_data_report_has_no_ground_truth_sections(demo, embed_dim):
 def test_every_figure_has_its_own_div(demo):
     page = demo["html"]
     targets = re.findall(r'class="figure" data-target="([^"]+)"', page)
-    assert len(targets) == 4  # persistence, cloud, arena, animation of the one region
+    assert len(targets) == 5  # timeline, persistence, cloud, arena, animation of the one region
     for target in targets:
         assert len(re.findall(rf'\bid="{target}"', page)) == 1
         assert re.search(rf'<div id="{target}" class="plot', page)

@@ -28,9 +28,10 @@ segments of constant value u, the cut minimising
 
     sum over segments of #{windows k in the segment : c_k != u}  +  CHANGE_PENALTY x (segments - 1),
 
-(an exact dynamic programme; ties go to fewer segments, then to the smaller value).  A
-segment must so be backed by more than CHANGE_PENALTY windows more than contradict it
-at a log's end, more than 2 x CHANGE_PENALTY in its middle.  A dimension without change has
+(an exact dynamic programme, vectorised over the start of the last segment; ties go to
+its earliest start, then to the smaller value).  A segment must so be backed by more
+than CHANGE_PENALTY windows more than contradict it at a log's end, more than
+2 x CHANGE_PENALTY in its middle.  A dimension without change has
 one segment whose value and confidence are the map's own (pooled) answer.  Otherwise
 a segment's confidence is the median confidence of its windows that read its value;
 segments run from change point to change point (the first from the first window's
@@ -168,13 +169,12 @@ def segment(values: list[int], penalty: float = CHANGE_PENALTY) -> list[tuple[in
     best = np.full(k + 1, np.inf)
     best[0] = -penalty
     choice = [(0, 0)] * (k + 1)
-    for j in range(1, k + 1):
-        for i in range(j):
-            agree = counts[:, j] - counts[:, i]
-            u = int(np.argmax(agree))  # the first (smallest) value on ties
-            cost = best[i] + penalty + (j - i - agree[u])
-            if cost < best[j] - 1e-9:
-                best[j], choice[j] = cost, (i, u)
+    for j in range(1, k + 1):  # every start i < j at once
+        agree = counts[:, j:j + 1] - counts[:, :j]  # (values, i)
+        u = np.argmax(agree, axis=0)  # the first (smallest) value on ties
+        cost = best[:j] + penalty + (j - np.arange(j) - agree[u, np.arange(j)])
+        i = int(np.argmin(cost))  # the first (fewest-segment prefix) on ties
+        best[j], choice[j] = cost[i], (i, int(u[i]))
     cuts, j = [], k
     while j > 0:
         i, u = choice[j]

@@ -275,7 +275,12 @@ def _timeline_figure(timeline: dict, true_timeline: list | None) -> dict:
     longest = max([max(w["h1_scaled_lengths"], default=0) for w in windows] + [1.0])
     levels = np.geomspace(1.0, max(longest, 1.01), 60)
     z = [[int(np.sum(np.asarray(w["h1_scaled_lengths"]) > level)) for w in windows] for level in levels]
-    traces.append({"type": "heatmap", "x": t, "y": _floats(levels, 4), "z": z, "colorscale": "Viridis",
+    top = max(max(row) for row in z)
+    # a contour plot (as CROCKER plots are drawn): filled SVG bands, one per whole number of bars
+    # (a heatmap would be drawn through an image the page would load from a data: URL)
+    traces.append({"type": "contour", "x": t, "y": _floats(levels, 4), "z": z, "colorscale": "Viridis",
+                   "contours": {"coloring": "fill", "start": 0.5, "end": top + 0.5, "size": 1, "showlines": False},
+                   "line": {"smoothing": 0}, "zmin": 0, "zmax": max(top, 1),
                    "colorbar": {"title": {"text": "H1 bars"}, "len": 0.4, "y": 0.2}, "xaxis": "x2", "yaxis": "y2",
                    "hovertemplate": "t %{x:.1f} s, length / median > %{y:.3g}: %{z} bars<extra></extra>"})
     return {"data": traces, "layout": {
