@@ -9,7 +9,7 @@ shipped ``CHANGE_PENALTY`` is the least penalty whose false alarms on the static
 controls are at most 5 % with the most changes found (docs/timeline.md, "How the
 penalty was chosen").
 
-    python lab/tune_timeline.py [--store lab-timeline.duckdb] [--per-cell 8] [--workers 2]
+    python lab/tune_timeline.py [--store lab-timeline.duckdb] [--per-cell 16] [--workers 2]
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ def cut_changes(windows: list[dict], penalty: float) -> list[tuple[int, int, int
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--store", default="lab-timeline.duckdb")
-    parser.add_argument("--per-cell", type=int, default=TUNING_PER_CELL)
+    parser.add_argument("--per-cell", type=int, default=2 * TUNING_PER_CELL)
     parser.add_argument("--workers", type=int, default=None)
     args = parser.parse_args()
     todo = jobs("tuning", args.per_cell)

@@ -71,8 +71,8 @@ def test_a_change_point_lies_between_the_last_old_window_and_the_first_new_one()
     assert tl.summary() == "beta_1 = 1 until about 65 s, then 2"
     assert list(tl.table()) == ["t0", "t1", "t", "n_events", "beta_0", "confidence_0", "beta_1", "confidence_1"]
     assert tl.table()["beta_1"].tolist() == [1] * 6 + [2] * 6
-    # five windows on each side are one change point short of the default penalty (5 windows)
-    assert build_timeline(windows[1:-1], 20.0, 10.0, {0: 1, 1: 2}, {0: 0.95, 1: 0.7}).changes == []
+    # three windows on each side do not pay for a change point at the default penalty (3 windows)
+    assert build_timeline(windows[3:-3], 20.0, 10.0, {0: 1, 1: 2}, {0: 0.95, 1: 0.7}).changes == []
 
 
 def test_a_log_that_did_not_change_has_one_segment_per_dimension_and_no_change():

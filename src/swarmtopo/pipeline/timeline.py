@@ -67,7 +67,7 @@ from .windows import evenly, window_spans
 MAX_TIMELINE_WINDOWS = 48
 """Most windows of a timeline of its own length and step, as many as the map's own windows
 (``MAX_WINDOWS``): a longer log keeps an evenly spaced share."""
-CHANGE_PENALTY = 5.0
+CHANGE_PENALTY = 3.0
 """Windows a change point costs in :func:`segment` (module docstring): the least penalty
 whose false alarms on the static tuning logs of ``swarmtopo bench timeline`` are at most
 5 % (``lab/tune_timeline.py``, docs/timeline.md)."""
