@@ -200,3 +200,28 @@ def test_a_confidence_the_map_withholds_the_timeline_withholds_too():
     assert all(w.confidence[1] is None for w in tl.windows) and all(w.confidence[0] == 0.99 for w in tl.windows)
     (change,) = tl.changes
     assert change.confidence is None and all(s.confidence is None for s in tl.segments[1])
+
+
+def test_bench_timeline_writes_and_prints_its_report(tmp_path, monkeypatch):
+    from conftest import run_cli
+
+    import swarmtopo.experiments.timeline as bench
+
+    truth = [{"from": 0.0, "until": 70.0, "beta_0": 1, "beta_1": 1},
+             {"from": 70.0, "until": 150.0, "beta_0": 1, "beta_1": 2}]
+    found = {"dimension": 1, "t": 75.0, "from": 1, "to": 2, "interval": [60.0, 90.0], "confidence": 0.8}
+    record = {"kind": "appear", "cell": "hole appears, 300 agents", "agents": 300, "pooled_right": False,
+              "status": "ok", **score(truth, [found])}
+
+    def run_benchmark(store, *, quick, scheduler, workers, progress):
+        progress(1, 1, 0)
+        return {"suite": bench.SUITE, "split": "reporting", "cases_per_cell": 1, "within_seconds": bench.WITHIN,
+                "seconds": 1.0, "jobs_run": 1, "workers": 1, "table": table([record]), "records": [record]}
+
+    monkeypatch.setattr(bench, "run_benchmark", run_benchmark)
+    done = run_cli("bench", "timeline", "--store", str(tmp_path / "t.duckdb"), "--out", str(tmp_path / "out"))
+    assert done.returncode == 0, done.stderr
+    assert "| hole appears, 300 agents | 1 | 100 % (1/1) | 100 % (1/1) | 5.0 s |" in done.stdout
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["timeline.json", "timeline.md"]
+    doc = json.loads((tmp_path / "out" / "timeline.json").read_text())
+    assert doc["table"]["overall"]["found_within"]["rate"] == 1.0 and doc["wall_seconds"] >= 0

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import cached_property
 from typing import Any
 
 import shapely
@@ -26,7 +25,8 @@ from shapely.geometry import MultiPolygon, Polygon, mapping
 from shapely.ops import unary_union
 
 from ._validate import positive
-from .arena import MM_PER_UNIT, Arena, _geometry_from, _units, random_arena, two_rooms_arena
+from .arena import (MM_PER_UNIT, Arena, _geometry_from, _regular_polygon, _units, default_arena, random_arena,
+                    two_rooms_arena)
 from .errors import ArenaError, SwarmtopoError
 
 ROLES = ("obstacle", "wall")
@@ -64,6 +64,7 @@ class ChangingArena:
         self.base = base
         self.obstacles = tuple(obstacles)
         self.source = source
+        self._epochs: dict[tuple[int, ...], Arena] = {(): base}  # the free space per set of obstacles present
         for i, ob in enumerate(self.obstacles):
             if not (0 <= ob.start < ob.end):
                 raise ArenaError(f"obstacle {i}: 'from' {ob.start:g} must be >= 0 and before 'until' {ob.end:g}",
@@ -87,21 +88,15 @@ class ChangingArena:
         return self._epoch(self.present(float(t)))
 
     def _epoch(self, present: tuple[int, ...]) -> Arena:
-        cache = self.__dict__.setdefault("_epochs", {})
-        if present not in cache:
-            if not present:
-                cache[present] = self.base
-            else:
-                removed = unary_union([self.obstacles[i].polygon for i in present])
-                free = self.base.geometry.difference(removed)
-                free = MultiPolygon([g for g in getattr(free, "geoms", [free]) if isinstance(g, Polygon) and g.area > 0])
-                names = ", ".join(str(i) for i in present)
-                try:
-                    cache[present] = Arena(free, source=self.source)
-                except ArenaError as exc:
-                    raise ArenaError(f"with obstacle(s) {names} present the free space is not a valid arena: "
-                                     f"{exc.reason}", file=self.source) from None
-        return cache[present]
+        if present not in self._epochs:
+            free = self.base.geometry.difference(unary_union([self.obstacles[i].polygon for i in present]))
+            free = MultiPolygon([g for g in getattr(free, "geoms", [free]) if isinstance(g, Polygon) and g.area > 0])
+            try:
+                self._epochs[present] = Arena(free, source=self.source)
+            except ArenaError as exc:
+                raise ArenaError(f"with obstacle(s) {', '.join(map(str, present))} present the free space is not a "
+                                 f"valid arena: {exc.reason}", file=self.source) from None
+        return self._epochs[present]
 
     @property
     def betti(self) -> tuple[int, int]:
@@ -147,22 +142,19 @@ class ChangingArena:
             features.append({"type": "Feature", "properties": props, "geometry": mapping(ob.polygon)})
         return {"type": "FeatureCollection", "features": features}
 
-    @cached_property
-    def geometry(self):
-        """The base free space (what pictures draw under the obstacles)."""
-        return self.base.geometry
-
     def __repr__(self) -> str:
         return f"ChangingArena({self.base!r}, {len(self.obstacles)} timed obstacle(s), changes at {self.change_times()})"
 
 
-def betti_timeline_of(arena, end: float = math.inf) -> list[dict[str, Any]]:
+def betti_timeline_of(arena: Arena | ChangingArena, end: float = math.inf) -> list[dict[str, Any]]:
     """The true Betti numbers over [0, end) of an Arena (one interval) or a ChangingArena."""
-    times = [t for t in getattr(arena, "change_times", lambda: [])() if t < end]
-    bounds = [0.0, *times, float(end)]
+    if isinstance(arena, Arena):
+        b0, b1 = arena.betti
+        return [{"from": 0.0, "until": float(end), "beta_0": b0, "beta_1": b1}]
+    bounds = [0.0, *(t for t in arena.change_times() if t < end), float(end)]
     out: list[dict[str, Any]] = []
     for t0, t1 in zip(bounds[:-1], bounds[1:]):
-        b0, b1 = (arena.at(t0) if hasattr(arena, "at") else arena).betti
+        b0, b1 = arena.at(t0).betti
         if out and (out[-1]["beta_0"], out[-1]["beta_1"]) == (b0, b1):
             out[-1]["until"] = t1
         else:
@@ -212,7 +204,7 @@ def _seconds(props: dict, key: str, default: float, source, where: str) -> float
     value = props.get(key, default)
     if value is None:
         return default
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value >= 0 or math.isnan(value):
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value >= 0:  # NaN too
         raise ArenaError(f"{where}properties.{key} {value!r} is not a time in seconds >= 0", file=source)
     return float(value)
 
@@ -271,7 +263,5 @@ def timeline_text(timeline: list[dict[str, Any]]) -> str:
 def changing_demo_arena() -> ChangingArena:
     """``swarmtopo demo --changing``'s arena: the demo arena (:func:`~swarmtopo.arena.default_arena`),
     in which a second hole, an 80 mm disc centred at (400, 400) mm, appears at t = 60 s."""
-    from .arena import _regular_polygon, default_arena
-
     disc = shapely.affinity.translate(_regular_polygon(64, 40.0, 0.0), 400.0, 400.0)
     return ChangingArena(default_arena(), [TimedObstacle(disc, 60.0, math.inf)])

@@ -726,36 +726,51 @@ def bench_accuracy(
     The full run also maps the planning grid (agents and duration varied apart) and fits
     plan.json on both; --quick fits it on its reporting maps without the swarm-size terms.
     """
+    from ._json import write_json
+    from .experiments.accuracy import PLANNING_PER_CELL, markdown, run_benchmark
+    from .experiments.plan import fit_plan
+
+    def plan(summary, command, folder) -> list[Path]:
+        try:
+            # ln N and ln N ln T are only told apart from ln T by the planning grid (the suite's budgets
+            # raise N and T together)
+            return [write_json(fit_plan(summary["records"] + summary["planning"], source=command,
+                                        swarm_terms=2 if summary["planning"] else 0).to_json(), folder / "plan.json")]
+        except SwarmtopoError as exc:
+            _warn(f"no plan.json: {exc}", quiet)
+            return []
+
+    _bench_report("accuracy", out_dir, store, quiet, verbose, markdown, extra_files=("plan.json",), extra=plan,
+                  run=lambda tick: run_benchmark(store, quick=quick, scheduler=scheduler, workers=workers,
+                                                 progress=tick, planning_per_cell=0 if quick else PLANNING_PER_CELL))
+
+
+def _bench_report(name: str, out_dir: Path, store: Path, quiet: bool, verbose: bool, markdown, run,
+                  extra_files: tuple[str, ...] = (), extra=None) -> None:
+    """Run a benchmark (``run(progress)`` -> its summary) into ``out_dir``: NAME.json, NAME.md
+    (``markdown(summary, command)``, also printed) and what ``extra(summary, command, folder)``
+    writes, the folder staged before the maps (an unwritable --out fails at once); the store
+    is never staged: it resumes."""
     import shlex
     import time
 
-    from .experiments.accuracy import PLANNING_PER_CELL, markdown, run_benchmark
     from ._json import write_json
-    from .experiments.plan import fit_plan
 
     _check_verbosity(quiet, verbose)
     command = "swarmtopo " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     start = time.perf_counter()
-    # staged before the hour of maps (an unwritable --out fails now); the store is never staged: it resumes
-    with output.staged_folder(out_dir, ("accuracy.json", "accuracy.md", "plan.json"), what="accuracy report",
+    with output.staged_folder(out_dir, (f"{name}.json", f"{name}.md", *extra_files), what=f"{name} report",
                               overwrite=True, note=f"finished maps are saved in {store}; run the same command "
                                                    "again to run the rest") as stage:
-        with _sweep_progress(quiet, verbose, label="accuracy") as tick:
-            summary = run_benchmark(store, quick=quick, scheduler=scheduler, workers=workers, progress=tick,
-                                    planning_per_cell=0 if quick else PLANNING_PER_CELL)
+        with _sweep_progress(quiet, verbose, label=name) as tick:
+            summary = run(tick)
         summary["wall_seconds"] = time.perf_counter() - start
         text = markdown(summary, command)
-        written = [write_json({k: v for k, v in summary.items()}, stage.path / "accuracy.json")]
-        (stage.path / "accuracy.md").write_text(text, encoding="utf-8")
-        written.append(stage.path / "accuracy.md")
-        try:
-            # ln N and ln N ln T are only told apart from ln T by the planning grid (the suite's budgets
-            # raise N and T together)
-            written.append(write_json(fit_plan(summary["records"] + summary["planning"], source=command,
-                                               swarm_terms=2 if summary["planning"] else 0).to_json(),
-                                      stage.path / "plan.json"))
-        except SwarmtopoError as exc:
-            _warn(f"no plan.json: {exc}", quiet)
+        written = [write_json(summary, stage.path / f"{name}.json")]
+        (stage.path / f"{name}.md").write_text(text, encoding="utf-8")
+        written.append(stage.path / f"{name}.md")
+        if extra is not None:
+            written += extra(summary, command, stage.path)
     if not quiet:
         out.print(text, markup=False, highlight=False, soft_wrap=True)
         out.print(f"wrote {', '.join(str(stage.final_path(p)) for p in written)}", markup=False, highlight=False,
@@ -789,29 +804,11 @@ def bench_timeline(
     stripped of ground truth on Dask; prints the share of changes found (within 15 s),
     the error of the change time, and the false change points.
     """
-    import shlex
-    import time
-
-    from ._json import write_json
     from .experiments.timeline import markdown, run_benchmark
 
-    _check_verbosity(quiet, verbose)
-    command = "swarmtopo " + " ".join(shlex.quote(a) for a in sys.argv[1:])
-    start = time.perf_counter()
-    with output.staged_folder(out_dir, ("timeline.json", "timeline.md"), what="timeline report", overwrite=True,
-                              note=f"finished maps are saved in {store}; run the same command again to run the "
-                                   "rest") as stage:
-        with _sweep_progress(quiet, verbose, label="timeline") as tick:
-            summary = run_benchmark(store, quick=quick, scheduler=scheduler, workers=workers, progress=tick)
-        summary["wall_seconds"] = time.perf_counter() - start
-        text = markdown(summary, command)
-        written = [write_json(summary, stage.path / "timeline.json")]
-        (stage.path / "timeline.md").write_text(text, encoding="utf-8")
-        written.append(stage.path / "timeline.md")
-    if not quiet:
-        out.print(text, markup=False, highlight=False, soft_wrap=True)
-        out.print(f"wrote {', '.join(str(stage.final_path(p)) for p in written)}", markup=False, highlight=False,
-                  soft_wrap=True)
+    _bench_report("timeline", out_dir, store, quiet, verbose, markdown,
+                  run=lambda tick: run_benchmark(store, quick=quick, scheduler=scheduler, workers=workers,
+                                                 progress=tick))
 
 
 @app.command(epilog="Examples: swarmtopo plan --area 250000 --agents 200 --duration 30;  "

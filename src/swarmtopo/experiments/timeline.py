@@ -28,8 +28,7 @@ from typing import Any
 import numpy as np
 
 from ..arena import HOLE_SHAPES, OUTER_SHAPES
-from ..topology.cycles import wilson_interval
-from .accuracy import PIPELINES
+from .accuracy import PIPELINES, Rate
 from .grid import Job, canonical_json, suite_case_seed
 from .sweep import first_placeable
 
@@ -163,10 +162,6 @@ def records(rows) -> list[dict[str, Any]]:
     return out
 
 
-def _rate(k: int, n: int) -> dict[str, Any]:
-    return {"right": k, "total": n, "rate": k / n if n else None, "wilson95": list(wilson_interval(k, n)) if n else None}
-
-
 def table(recs: list[dict[str, Any]]) -> dict[str, Any]:
     """Per cell and overall: changes found, found within ``WITHIN`` s, the time error's
     median and 90th percentile, the intervals' coverage, false changes, and the static
@@ -178,14 +173,15 @@ def table(recs: list[dict[str, Any]]) -> dict[str, Any]:
         expected = sum(r["expected"] for r in changing)
         return {
             "logs": len(subset),
-            "found": _rate(sum(r["found"] for r in changing), expected),
-            "found_within": _rate(sum(r["within"] for r in changing), expected),
+            "found": Rate(sum(r["found"] for r in changing), expected).to_json(),
+            "found_within": Rate(sum(r["within"] for r in changing), expected).to_json(),
             "error_median": float(np.median(errors)) if errors else None,
             "error_p90": float(np.percentile(errors, 90)) if errors else None,
-            "interval_coverage": _rate(sum(r["covered"] for r in changing), sum(r["found"] for r in changing)),
+            "interval_coverage": Rate(sum(r["covered"] for r in changing),
+                                      sum(r["found"] for r in changing)).to_json(),
             "false_changes_on_changing": sum(r["false"] for r in changing),
-            "false_alarms": _rate(sum(r["false"] > 0 for r in static), len(static)),
-            "static_pooled_right": _rate(sum(r["pooled_right"] for r in static), len(static)),
+            "false_alarms": Rate(sum(r["false"] > 0 for r in static), len(static)).to_json(),
+            "static_pooled_right": Rate(sum(r["pooled_right"] for r in static), len(static)).to_json(),
         }
     cells = {cell.name: summarise([r for r in recs if r["cell"] == cell.name]) for cell in CELLS}
     return {"overall": summarise(recs), "cells": {k: v for k, v in cells.items() if v["logs"]},

@@ -35,15 +35,15 @@ from ..readers.registry import load_classifier, shipped_reader_for
 from ..topology.cycles import region_cycles
 from ..topology.embed import mds
 from ..topology.persistence import Diagram, rips_persistence
-from .config import WHOLE_LOG, MapConfig
+from .config import MapConfig
 from .engine import engine_for
 from .regions import MIN_REGION_AGENTS, split_regions
 from .result import RegionMap, RegionScales, TimelineWindow, TopologicalMap, WindowMap, software_versions
 from .settings import Settings, resolve
 from .tasks import AUTO_COVER_FACTOR, cut_window, describe_part, map_band, window_part
-from .timeline import (build_timeline, no_timeline_note, read_component, scaled_h1, split_window, timeline_settings,
-                       timeline_spans, timeline_window)
-from .windows import silence_warnings
+from .timeline import (build_timeline, no_timeline_note, own_spans, read_component, scaled_h1, split_window,
+                       timeline_settings, timeline_window)
+from .windows import events_in, silence_warnings
 CALIBRATED_HOLES = 3
 """The most holes of any arena the confidence was calibrated on (the accuracy
 benchmark's cells: 0-3); a map counting more says its confidence is extrapolated."""
@@ -93,11 +93,8 @@ def map_encounters(
     config = (config or MapConfig()).validate()
     reader = reader or load_classifier(shipped_reader_for(log))
     settings = resolve(log, config, reader)
-    own_timeline = config.timeline_length is not None or config.timeline_step is not None
-    if own_timeline:  # a step too small for the log is refused before any map work
-        length, step = timeline_settings(config, settings.window_length[0])
-        if length != WHOLE_LOG:
-            timeline_spans(settings.times, length, step, config.min_region_events)
+    # a timeline of its own windows, decided now: a step too small for the log is refused before any map work
+    timeline_spans = own_spans(config, settings.window_length[0], settings.times)
     rng = np.random.default_rng(config.seed)
     say = progress or (lambda stage: None)
     timings = dict.fromkeys(STAGES, 0.0)
@@ -120,7 +117,7 @@ def map_encounters(
             region_of_event[graph.event_index[split.event_comp == comp]] = r
         shared_regions = engine.share(region_of_event)
         plans, splits = _plan_windows(engine, shared_chains, shared_log, shared_regions, graph, split, config,
-                                      settings, say, timeline=not own_timeline)
+                                      settings, say, timeline=timeline_spans is None)
         say("persistence")
         regions = []
         for comp, (plan, notes), n_land in zip(split.regions, plans, shares):
@@ -129,9 +126,8 @@ def map_encounters(
         say("timeline")
         t0 = time.perf_counter()
         # one draw after all the map's others: the rest of the map is the same with or without it
-        timeline_windows, length, step = _map_timeline(engine, shared_chains, shared_log, shared_regions, splits,
-                                                       regions, shares, config, settings, reader,
-                                                       int(rng.integers(2**63)))
+        timeline_windows = _map_timeline(engine, shared_chains, shared_log, shared_regions, splits, timeline_spans,
+                                         regions, shares, config, settings, reader, int(rng.integers(2**63)))
         timings["timeline"] = time.perf_counter() - t0
 
     betti: dict[int, int | None] = {0: len(regions)}
@@ -140,6 +136,7 @@ def map_encounters(
         known = all(n in r.betti for r in regions)
         betti[n] = sum(r.betti[n] for r in regions) if known else None
         confidence[n] = reader.map_confidence([r.confidence.get(n) for r in regions], n) if known else None
+    length, step = timeline_settings(config, settings.window_length[0])
     timeline = build_timeline(timeline_windows, length, step, betti, confidence, log,
                               note=None if timeline_windows else no_timeline_note(config, length))
     return TopologicalMap(
@@ -171,15 +168,15 @@ def _plan_windows(engine, shared_chains, shared_log, shared_regions, graph, spli
                   settings: Settings, say, timeline: bool) -> tuple[list[tuple[list, list[str]]], list]:
     """Per region: the (part, span, PartInfo) of every window that holds enough of it (its
     whole log instead when none does), the parts left on the engine, and notes on what
-    was skipped; and (``timeline``) each window's split into regions, a task
-    (:func:`.timeline.split_window`).  Every window's graph is cut once and shared by the
-    regions and the split."""
+    was skipped; and (``timeline``) each window's (span, split into regions), the split a
+    task (:func:`.timeline.split_window`).  Every window's graph is cut once and shared by
+    the regions and the split."""
     say("landmarks")
     bands = settings.landmark_bands
     cuts = [engine.submit(cut_window, shared_chains, span) for span in settings.spans]
-    splits = [engine.submit(split_window, cut, shared_regions, shared_log, config.min_region_events,
-                            settings.agent_gap) if timeline and span is not None else None
-              for cut, span in zip(cuts, settings.spans)]
+    splits = [(span, engine.submit(split_window, cut, shared_regions, shared_log, config.min_region_events,
+                                   settings.agent_gap))
+              for cut, span in zip(cuts, settings.spans) if timeline and span is not None]
     parts, infos = [], []
     for comp in split.regions:
         region_events = engine.share(graph.event_index[split.event_comp == comp])
@@ -209,57 +206,42 @@ def _plan_windows(engine, shared_chains, shared_log, shared_regions, graph, spli
     return plans, splits
 
 
-def _map_timeline(engine, shared_chains, shared_log, shared_regions, splits: list, regions: list[RegionMap],
-                  shares, config: MapConfig, settings: Settings, reader: BettiReader,
-                  entropy: int) -> tuple[list[TimelineWindow], float, float]:
-    """The timeline's windows (:mod:`.timeline`), read: the map's own windows, each
-    region part the map mapped read again on its own and any other component of a
-    window (a region that split) mapped as a task; or, with ``timeline_length`` or
-    ``timeline_step`` set, windows of their own, every component mapped as a task.
-    Returns (windows, their length, step)."""
-    length, step = timeline_settings(config, settings.window_length[0])
-    if splits and any(s is not None for s in splits):  # the map's windows
-        spans, step = settings.spans, config.window_step
-        mapped: dict[tuple, list[WindowMap]] = {}
+def _map_timeline(engine, shared_chains, shared_log, shared_regions, splits: list, spans: list | None,
+                  regions: list[RegionMap], shares, config: MapConfig, settings: Settings, reader: BettiReader,
+                  entropy: int) -> list[TimelineWindow]:
+    """The timeline's windows (:mod:`.timeline`), read, in order of their middles.
+    ``spans`` None: the map's own windows (``splits``: their (span, split) tasks), each
+    region part the map mapped read again on its own and any other component of a window
+    (a region that split) mapped as a task; else windows of the timeline's own, cut,
+    split and every component mapped as tasks."""
+    mapped: dict[tuple, list[WindowMap]] = {}
+    if spans is None:
         for r, region in enumerate(regions):
             for w in region.windows:
                 mapped.setdefault((r, (w.t0, w.t1)), []).append(w)
-    else:  # windows of the timeline's own length and step
-        spans = [] if length == WHOLE_LOG else timeline_spans(settings.times, length, step, config.min_region_events)
-        splits = [engine.submit(split_window, engine.submit(cut_window, shared_chains, span), shared_regions,
-                                shared_log, config.min_region_events, settings.agent_gap) for span in spans]
-        mapped = {}
-    step = length / 2 if step is None else step
-    if not spans:
-        return [], length, step
-    kept = [(span, split) for span, split in zip(spans, splits) if split is not None]
-    pairs = [(span, split) for (span, _), split in zip(kept, engine.gather([split for _, split in kept]))
+    else:
+        splits = [(span, engine.submit(split_window, engine.submit(cut_window, shared_chains, span), shared_regions,
+                                       shared_log, config.min_region_events, settings.agent_gap)) for span in spans]
+    pairs = [(span, split) for (span, _), split in zip(splits, engine.gather([task for _, task in splits]))
              if split is not None]
     shared_reader = engine.share(reader)
-    readings, tasks = [], []
+    readings: list[list] = [[None] * len(split.components) for _, split in pairs]
+    tasks = []  # (window, component, task) of the components the map did not map
     for k, (span, split) in enumerate(pairs):
         for j, (label, region, own, _) in enumerate(split.components):
             windows = mapped.get((region, span)) if own else None
             if windows:
-                readings.append((reader.read([w.diagram for w in windows], [w.n_events for w in windows]),
-                                 scaled_h1(windows[0])))
+                readings[k][j] = (reader.read([w.diagram for w in windows], [w.n_events for w in windows]),
+                                  scaled_h1(windows[0]))
             else:
                 n_land = None if not config.landmarks else int(shares[max(region, 0)])
-                readings.append(None)
-                tasks.append((len(readings) - 1, engine.submit(read_component, shared_chains, span, label, n_land,
-                                                               config, settings.landmark_bands, shared_reader,
-                                                               entropy, k * 1_000 + j)))
-    for (i, _), result in zip(tasks, engine.gather([t for _, t in tasks])):
-        readings[i] = result
-    out, at = [], 0
-    for span, split in pairs:
-        mine = readings[at:at + len(split.components)]
-        at += len(split.components)
-        events = int(np.searchsorted(settings.times, span[1], side="right")
-                     - np.searchsorted(settings.times, span[0], side="left"))
-        out.append(timeline_window(span, events, split, mine, reader, config.maxdim))
-    out.sort(key=lambda w: (w.t0 + w.t1, w.t1 - w.t0))
-    return out, length, step
+                tasks.append((k, j, engine.submit(read_component, shared_chains, span, label, n_land, config,
+                                                  settings.landmark_bands, shared_reader, entropy, k * 1_000 + j)))
+    for (k, j, _), result in zip(tasks, engine.gather([task for *_, task in tasks])):
+        readings[k][j] = result
+    out = [timeline_window(span, events_in(settings.times, span), split, read, reader, config.maxdim)
+           for (span, split), read in zip(pairs, readings)]
+    return sorted(out, key=lambda w: (w.t0 + w.t1, w.t1 - w.t0))
 
 
 def _map_region(engine, plan, n_land: int | None, config: MapConfig, rng, timings) -> list[WindowMap]:

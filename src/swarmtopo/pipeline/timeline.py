@@ -62,7 +62,7 @@ from .config import WHOLE_LOG, MapConfig
 from .regions import split_regions
 from .result import ChangePoint, Segment, Timeline, TimelineWindow, WindowMap
 from .tasks import cut_window, describe_part, map_band
-from .windows import evenly, window_spans
+from .windows import scaled_windows
 
 MAX_TIMELINE_WINDOWS = 48
 """Most windows of a timeline of its own length and step, as many as the map's own windows
@@ -73,17 +73,6 @@ whose false alarms on the static tuning logs of ``swarmtopo bench timeline`` are
 5 % (``lab/tune_timeline.py``, docs/timeline.md)."""
 CROCKER_BARS = 12
 """Longest H1 bars per timeline window kept for the time x scale picture."""
-
-
-def timeline_spans(times: np.ndarray, length: float, step: float | None, min_events: int
-                   ) -> list[tuple[float, float]]:
-    """The timeline's windows over the sorted event ``times`` (module docstring)."""
-    spans = [s for s in window_spans(times, length, step) if s is not None]
-    spans = [s for s in spans if np.searchsorted(times, s[1], side="right")
-             - np.searchsorted(times, s[0], side="left") >= min_events]
-    if len(spans) > MAX_TIMELINE_WINDOWS:
-        spans = [spans[i] for i in evenly(len(spans), MAX_TIMELINE_WINDOWS)]
-    return spans
 
 
 @dataclass(frozen=True)
@@ -253,11 +242,28 @@ def date_split(log: EncounterLog, last: TimelineWindow, first: TimelineWindow, s
                                                                              float(times.min()))
 
 
-def timeline_settings(config: MapConfig, window_length: float) -> tuple[float, float | None]:
-    """(length, step) of the timeline's own windows: the config's ``timeline_length`` (else
-    the map's window length W) and ``timeline_step`` (None: half the length)."""
+def timeline_settings(config: MapConfig, window_length: float) -> tuple[float, float]:
+    """(length, step) of the timeline's windows: with ``timeline_length`` or
+    ``timeline_step`` set, its own (the length defaulting to the map's window length W);
+    else the map's W and ``window_step``; a step of None is half the length."""
+    own = config.timeline_length is not None or config.timeline_step is not None
     length = window_length if config.timeline_length is None else config.timeline_length
-    return length, config.timeline_step
+    step = config.timeline_step if own else config.window_step
+    return length, length / 2 if step is None else step
+
+
+def own_spans(config: MapConfig, window_length: float, times: np.ndarray) -> list[tuple[float, float]] | None:
+    """The windows of a timeline of its own length and step (``timeline_length`` or
+    ``timeline_step`` set) over the sorted event ``times``: at most ``MAX_TIMELINE_WINDOWS``,
+    evenly spaced, each holding ``min_region_events`` events (:func:`~.windows.scaled_windows`);
+    None for the map's own windows."""
+    if config.timeline_length is None and config.timeline_step is None:
+        return None
+    length, step = timeline_settings(config, window_length)
+    if length == WHOLE_LOG:
+        return []
+    spans, _ = scaled_windows(times, [length], step, MAX_TIMELINE_WINDOWS, config.min_region_events)
+    return [span for span in spans if span is not None]
 
 
 def no_timeline_note(config: MapConfig, length: float) -> str:

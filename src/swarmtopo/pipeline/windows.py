@@ -70,8 +70,7 @@ def scaled_windows(times: np.ndarray, lengths, step: float | None = None, cap: i
     per_length = []
 
     def enough(span) -> bool:
-        return span is None or (np.searchsorted(times, span[1], side="right")
-                                - np.searchsorted(times, span[0], side="left")) >= min_events
+        return span is None or events_in(times, span) >= min_events
 
     for length in lengths:
         spans = [span for span in window_spans(times, length, step) if span not in seen and enough(span)]
@@ -84,6 +83,11 @@ def scaled_windows(times: np.ndarray, lengths, step: float | None = None, cap: i
     keep = shares(sizes, cap)
     kept = [[spans[i] for i in evenly(len(spans), k)] for spans, k in zip(per_length, keep)]
     return [span for spans in kept for span in spans], total - int(keep.sum())
+
+
+def events_in(times: np.ndarray, span: tuple[float, float]) -> int:
+    """How many of the sorted event ``times`` lie in ``span`` = (t0, t1), ends included."""
+    return int(np.searchsorted(times, span[1], side="right") - np.searchsorted(times, span[0], side="left"))
 
 
 def shares(sizes: np.ndarray, cap: int) -> np.ndarray:

@@ -34,9 +34,7 @@ def arena_changed(agents: np.ndarray, free: Arena, walls, model) -> int:
     """Apply a change of the free space to the swarm (module docstring); returns how
     many agents were moved out of obstacles."""
     x, y = agents["x"], agents["y"]
-    inside = free.contains(x, y)
-    inside[inside] = free.distance_to_boundary(x[inside], y[inside]) > 2 * WALL_EPS
-    moved = np.flatnonzero(~inside)
+    moved = np.flatnonzero(~clear_of_walls(free, x, y))
     for i in moved:
         agents["x"][i], agents["y"][i] = _nearest_free(free, float(x[i]), float(y[i]))
     for i in range(len(agents)):
@@ -64,17 +62,18 @@ def _nearest_free(free: Arena, x: float, y: float) -> tuple[float, float]:
         step = STEP_IN
         while step > 100 * WALL_EPS:
             cx, cy = q.x + step * dx / norm, q.y + step * dy / norm
-            if _clear(free, cx, cy):
+            if clear_of_walls(free, np.array([cx]), np.array([cy]))[0]:
                 return cx, cy
             step /= 10
     xmin, ymin, xmax, ymax = free.bounds
     gx, gy = np.meshgrid(np.linspace(xmin, xmax, 101), np.linspace(ymin, ymax, 101))
     gx, gy = gx.ravel(), gy.ravel()
-    ok = free.contains(gx, gy)
-    ok[ok] = free.distance_to_boundary(gx[ok], gy[ok]) > 2 * WALL_EPS
-    k = int(np.argmin(np.where(ok, np.hypot(gx - x, gy - y), np.inf)))
+    k = int(np.argmin(np.where(clear_of_walls(free, gx, gy), np.hypot(gx - x, gy - y), np.inf)))
     return float(gx[k]), float(gy[k])
 
 
-def _clear(free: Arena, x: float, y: float) -> bool:
-    return bool(free.contains(x, y)) and float(free.distance_to_boundary(x, y)) > 2 * WALL_EPS
+def clear_of_walls(free: Arena, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Whether each point is inside the free space, more than 2 ``WALL_EPS`` from every wall."""
+    ok = free.contains(x, y)
+    ok[ok] = free.distance_to_boundary(x[ok], y[ok]) > 2 * WALL_EPS
+    return ok
