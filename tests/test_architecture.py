@@ -13,8 +13,8 @@ PACKAGE = Path(__file__).resolve().parent.parent / "src" / "swarmtopo"
 LAYERS = {
     "errors": 0, "data": 0,
     "_validate": 1, "_json": 1, "_dask_plugin": 1,
-    "log": 2, "arena": 2,
-    "changing": 3,
+    "beacon": 2, "arena": 2,
+    "log": 3, "changing": 3,
     "io": 4, "metric": 4, "topology": 4, "sim": 4,
     "readers": 5,
     "pipeline": 6,

@@ -21,6 +21,7 @@ The public names (loaded on first use, so ``import swarmtopo`` stays light):
 ``write_map``        map.json, report.html and figures into a folder
 ``Arena``            free space as polygons; ``random_arena``, ``default_arena``, ``read_arena``
 ``ChangingArena``    an arena whose obstacles come and go (``TimedObstacle``); ``changing_arena``
+``BeaconTrack``      a localized leader's track (``track_along``, ``long_axis_track``); ``hall_arena``
 ``EncounterLog``     the events a base station receives
 ``load_classifier``  a Betti reader by preset name (default, trace, paper) or file
 ``SwarmtopoError``, ``InputError``, ``ArenaError``   what bad input raises
@@ -52,6 +53,10 @@ _PUBLIC = {
     "ChangingArena": "swarmtopo.changing",
     "TimedObstacle": "swarmtopo.changing",
     "changing_arena": "swarmtopo.changing",
+    "BeaconTrack": "swarmtopo.beacon",
+    "track_along": "swarmtopo.beacon",
+    "long_axis_track": "swarmtopo.beacon",
+    "hall_arena": "swarmtopo.arena",
     "EncounterLog": "swarmtopo.log",
     "load_classifier": "swarmtopo.readers.registry",
     "SwarmtopoError": "swarmtopo.errors",

@@ -118,8 +118,9 @@ class Arena:
         pts = shapely.points(np.asarray(x, float), np.asarray(y, float))
         return shapely.distance(pts, self.geometry.boundary)
 
-    def sample_uniform(self, n: int, rng=None, *, clearance: float = 0.0) -> np.ndarray:
-        """Draw ``n`` points uniformly in the free space, at least ``clearance`` mm from walls.
+    def sample_uniform(self, n: int, rng=None, *, clearance: float = 0.0, within=None) -> np.ndarray:
+        """Draw ``n`` points uniformly in the free space, at least ``clearance`` mm from walls
+        (and inside the shapely geometry ``within`` when given).
 
         Rejection sampling in the bounding box of the free space shrunk by
         ``clearance``; returns an (n, 2) float64 array.  The clearance is tested
@@ -128,8 +129,11 @@ class Arena:
         n = non_negative_int("number of points", n)
         rng = np.random.default_rng(rng)
         region = self.geometry.buffer(-clearance) if clearance > 0 else self.geometry
+        if within is not None:
+            region = region.intersection(within)
         if region.is_empty:
-            raise ArenaError(f"no free space is farther than {clearance} mm from the walls")
+            raise ArenaError(f"no free space is farther than {clearance} mm from the walls"
+                             + ("" if within is None else " in the area asked for"))
         shapely.prepare(region)
         xmin, ymin, xmax, ymax = region.bounds
         accept_rate = max(region.area / ((xmax - xmin) * (ymax - ymin)), 1e-3)
@@ -345,6 +349,39 @@ def annulus_arena(r_outer: float, r_inner: float, *, segments: int = 128, center
     outer = _regular_polygon(segments, r_outer, 0.0)
     inner = _regular_polygon(segments, r_inner, 0.0)
     return Arena(shapely.affinity.translate(Polygon(outer.exterior, [inner.exterior]), cx, cy))
+
+
+HALL_SHAPES: tuple[str, ...] = ("square", "disc", "L", "triangle")
+"""Hole families of :func:`hall_arena` (thin walls are left out: along a hall they close it)."""
+
+
+def hall_arena(n_holes: int, *, length: float = 3000.0, width: float = 600.0, shapes=HALL_SHAPES,
+               hole_size: float | None = None, clearance: float | None = None, rng=None,
+               max_tries: int = PLACEMENT_TRIES) -> Arena:
+    """A long hall, ``length`` x ``width`` mm, with ``n_holes`` holes at random places
+    along it: an arena bigger than a swarm on a leash sees at once (beacon-led exploration).
+
+    Holes are placed as in :func:`random_arena` (families from ``shapes``), of size
+    ``hole_size`` (default 0.22 width: 132 mm in a 600 mm hall) and at least
+    ``clearance`` (default 0.2 width) from each other and the walls.
+    """
+    rng = np.random.default_rng(rng)
+    n_holes = non_negative_int("n_holes", n_holes)
+    length, width = positive("length", length), positive("width", width)
+    size = positive("hole_size", 0.22 * width if hole_size is None else hole_size)
+    clear = non_negative("clearance", 0.2 * width if clearance is None else clearance)
+    wall = shapely.box(0.0, 0.0, length, width)
+    holes = _place_holes(wall, n_holes, size, clear, _hole_shapes(shapes), rng, non_negative_int("max_tries", max_tries))
+    if holes is None:
+        raise SwarmtopoError(_placement_failure(n_holes, size, clear, f"{length:g} x {width:g} mm hall", max_tries))
+    return Arena(Polygon(wall.exterior, [h.exterior for h in holes]))
+
+
+def hall_demo_arena() -> Arena:
+    """``swarmtopo demo --beacon``'s arena: a 2,400 x 600 mm hall with a 140 mm square hole
+    at x = 700 mm and a 140 mm disc at x = 1,700 mm, both on its middle line."""
+    holes = [shapely.box(630.0, 230.0, 770.0, 370.0), shapely.Point(1700.0, 300.0).buffer(70.0, quad_segs=16)]
+    return Arena(Polygon(shapely.box(0.0, 0.0, 2400.0, 600.0).exterior, [h.exterior for h in holes]))
 
 
 def two_rooms_arena(

@@ -57,6 +57,8 @@ DEMO_AGENTS, DEMO_SECONDS = 200, 30.0
 """The demo's swarm: the accuracy benchmark's smallest budget."""
 CHANGING_DEMO_SWARM = (300, 120.0)
 """``demo --changing``'s swarm: agents and seconds (the second hole appears at 60 s)."""
+BEACON_DEMO_SWARM = (300, 300.0)
+"""``demo --beacon``'s swarm: agents and leash R (mm); the leader sweeps the hall at 2 mm/s."""
 DEMO_WRITER = "swarmtopo demo"
 """``written_by`` in the meta.json of the demo's log: the only log demo may replace."""
 MAX_SCALE = 1000.0
@@ -195,6 +197,15 @@ def simulate(
     trajectories: Optional[float] = typer.Option(None, "--trajectories", callback=_positive_option,
                                                  help="Also write positions every EVERY s."),
     fmt: str = typer.Option("csv", "--format", callback=_fmt_option, help="csv or parquet."),
+    beacon: Optional[str] = typer.Option(
+        None, "--beacon", metavar="PATH|sweep",
+        help="A leader carrying a beacon moves along PATH (a GeoJSON LineString with a 'speed' in mm/s, or a t,x,y "
+             "table) or, with 'sweep', along the middle of the arena's long axis once; agents farther than --leash "
+             "from it are steered back; the log gains beacon.csv (docs/exploration.md in the source repository)."),
+    leash: Optional[float] = typer.Option(None, "--leash", callback=_positive_option,
+                                          help="Leash R (mm) of --beacon: agents farther are steered towards it."),
+    leader_speed: float = typer.Option(2.0, "--leader-speed", callback=_positive_option,
+                                       help="Speed (mm/s) of the leader of --beacon sweep (default 2)."),
     overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar, no summary."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
@@ -219,6 +230,8 @@ def simulate(
     _check_option("--agents, --duration, --dt", check_run_size, agents, duration, dt)
     _check_option("--duration, --dt", check_duration, duration, dt)
     _check_option("--static-time", check_static_time, static_fraction, static_time, duration, dt)
+    if (beacon is None) != (leash is None):
+        raise typer.BadParameter("a leader needs both --beacon and --leash", param_hint="--beacon" if leash else "--leash")
 
     if arena:  # scaled like a sweep's file arena
         world = read_arena(arena) if scale == 1.0 else read_arena(arena).scaled(scale)
@@ -228,6 +241,8 @@ def simulate(
     for passage in world.narrow_passages(rd):
         _warn(f"{passage}, less than r_d = {rd:g} mm: the swarm may not tell them apart, and the map may miss "
               f"that hole", quiet)
+    leader = {} if beacon is None else {"beacon": _leader_track(beacon, world, leash, leader_speed, duration, quiet),
+                                        "leash": leash}
     if verbose:
         _detail(f"arena: {world.betti[0]} region(s), {world.betti[1]} hole(s), area {world.area:.0f} mm^2; "
                 f"{agents} agents, {duration:g} s, dt {dt:g} s, r_d {rd:g} mm, seed {seed}")
@@ -236,7 +251,7 @@ def simulate(
         with _progress("simulating", quiet) as tick:
             sim = run(world, agents, duration, dt=dt, sensing=SensingParams(r_d=rd), rng=seed,
                       static_fraction=static_fraction, static_time=static_time, truth=truth,
-                      trajectory_every=trajectories, progress=tick)
+                      trajectory_every=trajectories, progress=tick, **leader)
         if verbose:
             _detail(f"simulated in {time.perf_counter() - start:.2f} s: {sim.log.n_events} encounters, "
                     f"{len(sim.log.status_t)} status changes")
@@ -254,7 +269,24 @@ def simulate(
                 out.print(f"at t = {moved['t']:g} s the arena changed: {moved['agents']} agent(s) stood where an "
                           "obstacle appeared and were moved to the nearest free point", markup=False, highlight=False,
                           soft_wrap=True)
+        if leader:
+            share = sim.log.meta["simulation"]["leash"]["stimulated_share"]
+            out.print(f"a leader moved {leader['beacon'].distance_travelled(0.0, sim.log.meta['duration']):.0f} mm; "
+                      f"agents were beyond the leash R = {leash:g} mm (and steered back) {100 * share:.1f} % of the "
+                      "time", markup=False, highlight=False, soft_wrap=True)
         out.print(f"wrote {', '.join(str(p) for p in written)}", markup=False, highlight=False, soft_wrap=True)
+
+
+def _leader_track(beacon: str, world, leash: float, speed: float, duration: float, quiet: bool):
+    """The leader's track of ``simulate --beacon``: a file's, or ``sweep`` along the arena's long axis."""
+    from .beacon import long_axis_track
+    from .io.beacons import read_beacon_path
+
+    track = (long_axis_track(world.bounds, leash, speed) if beacon == "sweep" else read_beacon_path(Path(beacon)))
+    if track.t[-1] > duration:
+        _warn(f"the leader's track runs to t = {track.t[-1]:g} s, after the log ends at {duration:g} s: the "
+              "swarm explores only part of it (give a longer --duration)", quiet)
+    return track
 
 
 @app.command(epilog="Example: swarmtopo ingest primaryschool.csv --format sociopatterns --out runs/school "
@@ -464,6 +496,10 @@ def demo(
     changing: bool = typer.Option(False, "--changing",
                                   help="An arena that changes: a second hole appears at t = 60 s (300 agents, 120 s); "
                                        "the map's timeline says when."),
+    beacon: bool = typer.Option(False, "--beacon",
+                                help="A 2.4 m hall, bigger than the swarm sees at once, explored behind a leader: 300 "
+                                     "agents on a 300 mm leash, the leader sweeping the hall at 2 mm/s (about 13 "
+                                     "minutes of log); the map stitches its local maps into a global one."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
@@ -472,9 +508,11 @@ def demo(
     A 500 mm square with one hole, 200 agents, 30 s of data (the accuracy benchmark's
     smallest budget; the paper's figure has 20 s): prints the recovered
     Betti numbers beside the true ones and where the figures were written.  With
-    --changing, a second hole appears half-way through a longer log.
+    --changing, a second hole appears half-way through a longer log; with --beacon,
+    a long hall is explored behind a moving leader.
     """
-    from .arena import default_arena
+    from .arena import default_arena, hall_demo_arena
+    from .beacon import long_axis_track
     from .changing import changing_demo_arena, true_betti_text
     from .io.logs import log_files, write_log
     from .pipeline import MapConfig
@@ -489,12 +527,20 @@ def demo(
             if found:
                 raise SwarmtopoError(f"{folder}: already holds a {what} that swarmtopo demo did not write "
                                      f"({', '.join(p.name for p in found)}); choose another --out")
+    if changing and beacon:
+        raise typer.BadParameter("choose --changing or --beacon, not both")
     world, agents, seconds = ((changing_demo_arena(), *CHANGING_DEMO_SWARM) if changing
                               else (default_arena(), DEMO_AGENTS, DEMO_SECONDS))
+    leader = {}
+    if beacon:
+        world, (agents, leash) = hall_demo_arena(), BEACON_DEMO_SWARM
+        leader = {"beacon": long_axis_track(world.bounds, leash), "leash": leash}
+        seconds = float(np.ceil(leader["beacon"].t[-1] + 20.0))
     owned = {"log": [p.name for p in log_files(log_dir)], **dict.fromkeys(MAP_FILES)}  # the rest of D stays
     with output.staged_folder(out_dir, owned, what="demo", overwrite=True) as stage:
         with _progress("simulating", quiet) as tick:
-            sim = run(world, agents, seconds, rng=seed, truth=True, trajectory_every=0.5, progress=tick)
+            sim = run(world, agents, seconds, rng=seed, truth=True, trajectory_every=2.0 if beacon else 0.5,
+                      progress=tick, **leader)
         sim.log.meta["written_by"] = DEMO_WRITER
         write_log(sim.log, stage.path / "log", truth=sim.truth, trajectories=sim.trajectories, arena=world)
         if verbose:
@@ -785,6 +831,32 @@ def _plan_input_option(value: str) -> str:
     return value
 
 
+@bench_app.command("exploration", epilog="Example: swarmtopo bench exploration --quick --store exploration.duckdb "
+                                         "--workers 2  (run it again after Ctrl-C: finished maps are kept)")
+def bench_exploration(
+    quick: bool = typer.Option(False, "--quick", help="2 cases per cell instead of 12."),
+    store: Path = typer.Option(Path("exploration.duckdb"), "--store", help="DuckDB result store (resumable)."),
+    out_dir: Path = typer.Option(Path("exploration"), "--out", help="Folder for exploration.md and exploration.json."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Address of an existing Dask scheduler."),
+    workers: Optional[int] = typer.Option(None, "--workers", min=1,
+                                          help="Worker processes of the local cluster (default: all cores)."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
+) -> None:
+    """How well beacon-led exploration maps halls bigger than the swarm.
+
+    Simulates long halls (2.4-3.6 m x 0.5-0.7 m, 1-4 holes of mixed shapes) swept once
+    by a leader at 2 mm/s with 200-400 agents on a 250-400 mm leash; maps each log
+    stripped of ground truth on Dask; prints the share of exact global beta_1 and the
+    error of the holes' estimated positions.
+    """
+    from .experiments.exploration import markdown, run_benchmark
+
+    _bench_report("exploration", out_dir, store, quiet, verbose, markdown,
+                  run=lambda tick: run_benchmark(store, quick=quick, scheduler=scheduler, workers=workers,
+                                                 progress=tick))
+
+
 @bench_app.command("timeline", epilog="Example: swarmtopo bench timeline --quick --store timeline.duckdb --workers 2  "
                                       "(run it again after Ctrl-C: finished maps are kept)")
 def bench_timeline(
@@ -984,7 +1056,15 @@ def _print_verdict(tmap, truth) -> None:
                     f"beta_{n} not estimated (the classifier has no threshold for it)"
                     for n, b in sorted(tmap.betti.items()))
     timeline = tmap.timeline
-    if timeline is not None and timeline.changes:
+    if tmap.exploration is not None:  # its timeline's changes are holes coming into the swarm's view and leaving it
+        found = tmap.exploration
+        say(f"recovered: {est} (global map along the leader's path: {len(found.windows)} local maps, each hole "
+            "counted once; its confidence is not calibrated)")
+        for i, h in enumerate(found.holes, 1):
+            say(f"hole {i}:    at ({h.x:.0f}, {h.y:.0f}) mm, within {h.radius:.0f} mm (in view {h.t_in:.0f}-"
+                f"{h.t_out:.0f} s{', at an end of the path' if h.open else ''})")
+        timeline = None
+    elif timeline is not None and timeline.changes:
         say(f"recovered: the arena changed: {timeline.summary()}")
         for c in timeline.changes:
             sure = "" if c.confidence is None else f"; {format_confidence(c.confidence)} confidence"

@@ -24,6 +24,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
+from .beacon import BeaconTrack
 from .errors import InputError
 
 LOG_FORMAT = "swarmtopo-log/1"
@@ -58,6 +59,9 @@ class EncounterLog:
         provenance, and the declaration ``agent_count`` or ``agent_ids`` if the
         source gave one (the number of agents is :attr:`n_agents`, whatever meta
         says).  Never ground truth.
+    beacon
+        The track of a localized leader the swarm was kept near (``beacon.csv``,
+        :mod:`swarmtopo.beacon`), or None: the one position a log may hold.
     """
 
     t: np.ndarray
@@ -70,6 +74,7 @@ class EncounterLog:
     static_agent: np.ndarray = field(default_factory=lambda: np.empty(0, np.int64))
     static_time: np.ndarray = field(default_factory=lambda: np.empty(0))
     meta: dict[str, Any] = field(default_factory=dict)
+    beacon: BeaconTrack | None = None
 
     # -- construction ----------------------------------------------------------------
     @classmethod

@@ -10,7 +10,7 @@ Format (``examples/sweep-small.toml`` is a commented example)::
     diagrams = "map"          # diagrams each row keeps: none | map | windows (default "map")
 
     [arena]
-    generator = "random"      # random | default | square | annulus | two_rooms | file | changing
+    generator = "random"      # random | default | square | annulus | two_rooms | file | changing | hall
     holes = [1, 2, 3]         # random, two_rooms: number of holes (default 1)
     shapes = "square"         # random, two_rooms: hole families (default "square")
     outer = "square"          # random: outer wall square | rectangle | polygon
@@ -21,12 +21,17 @@ Format (``examples/sweep-small.toml`` is a commented example)::
     change = "appear"         # changing: none | appear (a hole appears) | disappear | door (a door
                               # closes between two rooms): swarmtopo.changing.changing_arena
     change_time = 60.0        # changing: when, s (before the swarm's duration)
+    length = 3000.0           # hall: length of a long hall, mm (swarmtopo.arena.hall_arena)
+    width = 600.0             # hall: its width, mm
 
     [swarm]
     agents = 200              # swarm size N (default 200)
     duration = 20.0           # seconds of data (default 20)
     static_fraction = 0.0     # fraction of agents stopped for good (default 0)
     static_time = 0.0         # when they stop, s (default 0; only with static_fraction > 0)
+    leash = 0.0               # R, mm: a leader sweeps the arena's long axis once and agents are kept
+                              # within R of it (swarmtopo.beacon.long_axis_track); 0 (default): no leader
+    leader_speed = 2.0        # the leader's speed, mm/s (only with leash > 0)
 
     [map]
     metric = "hybrid"         # plain | contracted | hybrid (default hybrid)
@@ -104,6 +109,7 @@ GENERATORS: dict[str, tuple[str, ...]] = {
     "two_rooms": ("holes", "shapes", "scale"),
     "file": ("path", "scale"),
     "changing": ("holes", "shapes", "outer", "scale", "change", "change_time"),
+    "hall": ("holes", "shapes", "length", "width"),
 }
 """Arena generators and the ``[arena]`` keys each one uses (besides ``generator``)."""
 STREAMS = ("arena", "simulation", "map")
@@ -203,10 +209,14 @@ PARAMS: tuple[Param, ...] = (
     Param("arena", "path", None, _text, "TEXT"),
     Param("arena", "change", "appear", _choice(CHANGES), "TEXT"),
     Param("arena", "change_time", 60.0, _number(0.0, strict=True), "DOUBLE"),
+    Param("arena", "length", 3000.0, _number(0.0, strict=True), "DOUBLE"),
+    Param("arena", "width", 600.0, _number(0.0, strict=True), "DOUBLE"),
     Param("swarm", "agents", 200, _integer(1), "INTEGER"),
     Param("swarm", "duration", 20.0, _number(0.0, strict=True), "DOUBLE"),
     Param("swarm", "static_fraction", 0.0, _number(0.0, strict=False, hi=1.0), "DOUBLE"),
     Param("swarm", "static_time", 0.0, _number(0.0, strict=False), "DOUBLE"),
+    Param("swarm", "leash", 0.0, _number(0.0, strict=False), "DOUBLE"),
+    Param("swarm", "leader_speed", 2.0, _number(0.0, strict=True), "DOUBLE"),
     *(Param("map", name, default, _option(name), sql) for name, default, sql in (
         ("metric", "hybrid", "TEXT"), ("hop_cost", "auto", "DOUBLE"), ("diffusion_time", "auto", "DOUBLE"),
         ("wall_follow_weight", MapConfig().wall_follow_weight, "DOUBLE"), ("window_length", "auto", "DOUBLE"),
@@ -544,6 +554,9 @@ def _canonical(point: dict, inputs: _InputFiles, fail):
     swarm = {name: point[("swarm", name)] for name in ("agents", "duration", "static_fraction")}
     if swarm["static_fraction"] > 0:
         swarm["static_time"] = point[("swarm", "static_time")]
+    if point[("swarm", "leash")] > 0:
+        swarm["leash"] = point[("swarm", "leash")]
+        swarm["leader_speed"] = point[("swarm", "leader_speed")]
 
     mapping = {name: point[("map", name)]
                for name in ("metric", "hop_cost", "diffusion_time", "wall_follow_weight", "window_length",
@@ -563,7 +576,7 @@ def _canonical(point: dict, inputs: _InputFiles, fail):
         files.append(("map.classifier", absolute))
 
     config = {"arena": arena, "swarm": swarm, "map": mapping}
-    used = {(table, key) for table, body in config.items() for key in body}
+    used = {(table, key) for table, body in config.items() for key in body} | {("swarm", "leash")}  # 0: no leader
     return config, tuple(files), used
 
 
@@ -591,6 +604,8 @@ def _unused_reason(table: str, key: str, document: dict) -> str:
                 f"(only by {', '.join(repr(g) for g in users)})")
     if key == "static_time":
         return "not used: static_fraction is 0 (no agent stops for good)"
+    if key == "leader_speed":
+        return "not used: leash is 0 (no leader)"
     if key in ("window_step", "window_scales"):
         return 'not used: window_length is "none" (the whole log at once)'
     if key == "window_encounters":

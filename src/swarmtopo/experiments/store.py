@@ -14,7 +14,8 @@ Tables
     see :func:`encode_regions`; ``diagrams_kept`` says which persistence diagrams it
     holds, :data:`~.grid.KEEP_LEVELS`), ``timeline`` JSON (the true Betti numbers over time,
     the map's change points and segments, and at level ``windows`` each timeline window's
-    counts: :func:`~.sweep.timeline_record`), sizes (``n_events, n_agents, n_regions, n_landmarks``),
+    counts: :func:`~.sweep.timeline_record`), ``exploration`` JSON (a swarm with a leader:
+    the global map and the true holes, :func:`~.sweep.exploration_record`), sizes (``n_events, n_agents, n_regions, n_landmarks``),
     stage timings in seconds (``t_simulate, t_graph, t_landmarks, t_persistence,
     t_classify, t_total``), ``versions`` JSON (software versions, and the classifier's
     name and Theta), ``worker`` (host:pid), ``finished_at`` (UTC), ``status`` and
@@ -72,7 +73,7 @@ _RESULTS = (
     ("est_betti0", "INTEGER"), ("est_betti1", "INTEGER"),
     ("confidence_betti0", "DOUBLE"), ("confidence_betti1", "DOUBLE"),
     ("snr_h1", "DOUBLE"), ("noise_power_h1", "DOUBLE"), ("lengths_h1", "DOUBLE[]"),
-    ("diagrams", "BLOB"), ("diagrams_kept", "TEXT"), ("timeline", "JSON"),
+    ("diagrams", "BLOB"), ("diagrams_kept", "TEXT"), ("timeline", "JSON"), ("exploration", "JSON"),
     ("n_events", "INTEGER"), ("n_agents", "INTEGER"), ("n_regions", "INTEGER"), ("n_landmarks", "INTEGER"),
     ("t_simulate", "DOUBLE"), ("t_graph", "DOUBLE"), ("t_landmarks", "DOUBLE"), ("t_persistence", "DOUBLE"),
     ("t_classify", "DOUBLE"), ("t_total", "DOUBLE"),
@@ -81,7 +82,7 @@ _RESULTS = (
 )
 JOB_COLUMNS: tuple[tuple[str, str], ...] = (*_IDENTITY, *((p.name, p.sql) for p in PARAMS), *_RESULTS)
 """(name, DuckDB type) of every column of ``jobs``, in order."""
-JSON_COLUMNS = ("config", "versions", "timeline")
+JSON_COLUMNS = ("config", "versions", "timeline", "exploration")
 """Columns holding JSON text; :func:`iter_jobs` returns them parsed."""
 RUN_COLUMNS = ("t_simulate", "t_graph", "t_landmarks", "t_persistence", "t_classify", "t_total",
                "versions", "worker", "finished_at")
@@ -523,7 +524,7 @@ def _tables(db) -> set[str]:
     return {name for (name,) in db.execute("SELECT table_name FROM information_schema.tables").fetchall()} & _TABLES
 
 
-NEW_COLUMNS = ("change", "change_time", "timeline")
+NEW_COLUMNS = ("change", "change_time", "timeline", "length", "width", "leash", "leader_speed", "exploration")
 """Columns added since stores had a runs table: a store without them gets them (NULL)
 when a sweep opens it, so its finished jobs are kept."""
 

@@ -34,7 +34,10 @@ from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from typing import Any, Callable, Iterable
 
-from ..arena import Arena, annulus_arena, default_arena, random_arena, square_arena, two_rooms_arena
+import shapely
+
+from ..arena import Arena, annulus_arena, default_arena, hall_arena, random_arena, square_arena, two_rooms_arena
+from ..beacon import long_axis_track
 from ..changing import ChangingArena, betti_timeline_of, changing_arena
 from ..readers.base import BettiReader
 from ..readers.registry import PRESETS, load_classifier
@@ -45,7 +48,7 @@ from ..topology.persistence import snr
 from ..pipeline import MapConfig, map_encounters
 from ..pipeline.engine import POLL_SECONDS, connected_client, deferred_interrupt, local_client
 from ..pipeline.result import software_versions
-from ..viz.summary import timeline_json, window_json
+from ..viz.summary import exploration_json, timeline_json, window_json
 from ..sim import simulate
 from .grid import (DEFAULT_JOB_TIMEOUT, KEEP_LEVELS, Job, case_streams, flat_columns, job_map_config,
                    job_simulation_args)
@@ -68,10 +71,13 @@ def build_arena(arena: dict[str, Any], rng, path: str | None = None) -> Arena | 
     path
         Absolute path of the GeoJSON file (``generator = "file"``).
     """
-    generator, scale = arena["generator"], arena["scale"]
+    generator, scale = arena["generator"], arena.get("scale", 1.0)
     if generator == "changing":
         return changing_arena(arena["change"], arena["holes"], arena.get("change_time", math.inf), shapes=arena["shapes"],
                               outer=arena["outer"], scale=scale, rng=rng)
+    if generator == "hall":
+        return hall_arena(arena["holes"], length=arena["length"], width=arena["width"], shapes=arena["shapes"],
+                          rng=rng)
     if generator == "random":
         return random_arena(arena["holes"], scale=scale, shapes=arena["shapes"], outer=arena["outer"], rng=rng)
     if generator == "two_rooms":
@@ -177,7 +183,11 @@ def run_job(job: Job, keep: str = "map") -> dict[str, Any]:
         arena = build_arena(config["arena"], seeds["arena"], job.file("arena.path"))
         row["true_betti0"], row["true_betti1"] = arena.betti
         t0 = time.perf_counter()
-        sim = simulate(arena, **job_simulation_args(swarm), rng=seeds["simulation"])
+        leader = {}
+        if swarm.get("leash"):
+            leader = {"leash": swarm["leash"],
+                      "beacon": long_axis_track(arena.bounds, swarm["leash"], swarm["leader_speed"])}
+        sim = simulate(arena, **job_simulation_args(swarm), **leader, rng=seeds["simulation"])
         row["t_simulate"] = time.perf_counter() - t0
         row["n_events"], row["n_agents"] = sim.log.n_events, sim.log.n_agents
         true_timeline = betti_timeline_of(arena, sim.log.meta["duration"])
@@ -203,6 +213,7 @@ def run_job(job: Job, keep: str = "map") -> dict[str, Any]:
             lengths_h1=[float(x) for x in tmap.diagram.lengths(1)],
             diagrams=encode_regions(regions), diagrams_kept=keep,
             timeline=timeline_record(tmap.timeline, true_timeline, keep),
+            exploration=exploration_record(tmap.exploration, arena, keep) if tmap.exploration else None,
             n_regions=len(tmap.regions), n_landmarks=sum(region["landmarks"] for region in regions),
             **{column: tmap.timings[stage] for stage, column in _STAGE_COLUMNS.items()},
         )
@@ -223,6 +234,16 @@ def timeline_record(timeline, truth: list[dict[str, Any]], keep: str) -> dict[st
     if keep == "windows":
         record["windows"] = [{k: w[k] for k in ("t0", "t1", "betti", "confidence")} for w in found["windows"]]
     return record
+
+
+def exploration_record(exploration, arena, keep: str) -> dict[str, Any]:
+    """A row's ``exploration`` column: the global map (:func:`~swarmtopo.viz.summary.exploration_json`;
+    its local maps only at ``keep = "windows"``) and the true holes' centroids (mm)."""
+    found = exploration_json(exploration)
+    if keep != "windows":
+        del found["windows"]
+    true = [shapely.Polygon(ring).centroid for region in arena.regions for ring in region.interiors]
+    return {**found, "true_holes": [[p.x, p.y] for p in true]}
 
 
 def failed_row(job: Job, status: str, message: str, seconds: float | None = None) -> dict[str, Any]:

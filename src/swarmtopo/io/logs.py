@@ -19,6 +19,9 @@ file                   columns / keys                       status
 ``truth.<fmt>``        ``t, a, b, xa, ya, xb, yb``, one     optional, ground truth
                        row per event in the events' order
 ``trajectories.<fmt>`` ``t, agent, x, y[, state]``          optional, ground truth
+``beacon.<fmt>``       ``t, x, y``: the track of a          optional (beacon-led
+                       localized leader (mm), with          exploration,
+                       ``meta.json`` ``leash`` (R, mm)      docs/exploration.md)
 =====================  ===================================  ==========================
 
 ``fmt`` is ``csv``, ``csv.gz`` (gzip-compressed CSV, read only) or ``parquet``, one of
@@ -52,6 +55,8 @@ import math
 import shutil
 from pathlib import Path
 
+from dataclasses import replace
+
 import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
@@ -61,6 +66,7 @@ import pyarrow.parquet as pq
 from .._json import atomic_write, os_reason
 from .._json import read_json, write_json
 from ..arena import Arena
+from ..beacon import BEACON_COLUMNS, BeaconTrack
 from ..errors import InputError, SwarmtopoError
 from ..log import LOG_FORMAT, EncounterLog, float_ids, parse_states, refuse_nul_ids, state_labels
 from .arenas import write_arena
@@ -79,7 +85,7 @@ GROUND_TRUTH_FILES = ("arena.geojson",
                       *(f"{stem}{suffix}" for stem in ("truth", "trajectories") for suffix in TABLE_SUFFIXES))
 """Files that only a simulator can write; ``swarmtopo map`` reads them for pictures only, never to estimate."""
 
-_TABLE_STEMS = ("events", "status", "truth", "trajectories")
+_TABLE_STEMS = ("events", "status", "truth", "trajectories", "beacon")
 _ID_COLUMNS = ("a", "b", "agent")
 
 
@@ -139,6 +145,8 @@ def write_log(
         tables["truth"] = _truth_columns(log, truth, ids_a, ids_b)
     if trajectories is not None:
         tables["trajectories"] = _trajectory_columns(trajectories)
+    if log.beacon is not None:
+        tables["beacon"] = {"t": log.beacon.t, "x": log.beacon.x, "y": log.beacon.y}
 
     written = [_write_table(columns, directory / f"{stem}.{fmt}") for stem, columns in tables.items()]
     written.append(write_json(_meta_for(log), directory / "meta.json"))
@@ -175,7 +183,7 @@ def log_files(directory) -> list[Path]:
 def read_log(directory) -> EncounterLog:
     """Read a log folder: ``events.<fmt>`` is required, everything else optional.
 
-    Only ``events``, ``status`` and ``meta.json`` are read -- never ground truth.
+    Only ``events``, ``status``, ``beacon`` and ``meta.json`` are read -- never ground truth.
     ``meta["static"]`` becomes the log's static agents; the rest of ``meta.json`` is
     ``log.meta``.  Unsorted events are sorted.
 
@@ -231,7 +239,18 @@ def read_log(directory) -> EncounterLog:
     if "duration" in meta and meta["duration"] < log.last_time:
         raise InputError(f"key 'duration' is {meta['duration']:g} s but the log runs to t = {log.last_time:g} s",
                          file=str(meta_path), column="duration", value=meta["duration"])
+    beacon_path = _find_table(directory, "beacon")
+    if beacon_path is not None:
+        log = replace(log, beacon=read_beacon_table(beacon_path))
     return log
+
+
+def read_beacon_table(path) -> BeaconTrack:
+    """A leader's track from a ``t, x, y`` table (CSV, CSV.gz or Parquet; seconds, mm)."""
+    path = Path(path)
+    table, rows = _read_table(path, BEACON_COLUMNS)
+    cols = [number_column(table[c], path, c, "time" if c == "t" else "position", rows) for c in BEACON_COLUMNS]
+    return BeaconTrack.from_columns(*cols, source=str(path), rows=rows)
 
 
 def _as_written(exc: InputError, tables: dict) -> InputError:
@@ -307,7 +326,7 @@ simulator's record (it holds the arena's Betti numbers) and its seed."""
 def strip_ground_truth(src_dir, dst_dir) -> None:
     """Copy a log folder without its ground truth.
 
-    ``dst_dir`` gets ``events.*``, ``status.*`` and ``meta.json`` without its
+    ``dst_dir`` gets ``events.*``, ``status.*``, ``beacon.*`` and ``meta.json`` without its
     ``GROUND_TRUTH_META_KEYS`` -- no ``arena.geojson``, ``truth.*``, ``trajectories.*`` and no
     file outside the contract.  Used to prove that ``swarmtopo map`` needs nothing else.
     ``dst_dir`` must not exist yet or be empty.
@@ -316,7 +335,7 @@ def strip_ground_truth(src_dir, dst_dir) -> None:
     if dst.exists() and (not dst.is_dir() or any(dst.iterdir())):
         raise InputError("destination must be a new or empty folder", file=str(dst))
     make_folder(dst)
-    for stem in ("events", "status"):
+    for stem in ("events", "status", "beacon"):
         path = _find_table(src, stem, required=stem == "events")
         if path is not None:
             atomic_write(dst / path.name, lambda tmp, path=path: shutil.copyfile(path, tmp))
@@ -500,7 +519,8 @@ def _extra_columns(table: dict[str, pa.Array], known: dict) -> dict[str, np.ndar
 
 
 NUMBER_META_KEYS = {"r_d": "detection radius, mm", "v_c": "random-walk speed, mm/s",
-                    "v_p": "wall-following speed, mm/s", "dt": "time step, s", "duration": "seconds recorded"}
+                    "v_p": "wall-following speed, mm/s", "dt": "time step, s", "duration": "seconds recorded",
+                    "leash": "leash R of a beacon-led swarm, mm"}
 """Keys of meta.json that, when present, must be finite numbers, positive (duration: >= 0)."""
 
 

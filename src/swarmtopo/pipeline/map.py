@@ -11,6 +11,7 @@ The stages, in order (paper, "Algorithm Overview", and swarmtopo's windows)::
     per region: Betti numbers and confidence        readers (one reader.read call)
     per region: MDS picture, loops round the holes  topology.embed, topology.cycles
     the timeline: sliding windows, change points    pipeline.timeline
+    a leader's log: local maps stitched             pipeline.exploration
     assemble the map                                pipeline.result
 
 Nothing here reads an arena, a truth file or simulator parameters: the map is a
@@ -37,6 +38,7 @@ from ..topology.embed import mds
 from ..topology.persistence import Diagram, rips_persistence
 from .config import MapConfig
 from .engine import engine_for
+from .exploration import MAX_EXPLORATION_WINDOWS, exploration_length, leash_of, stitch
 from .regions import MIN_REGION_AGENTS, split_regions
 from .result import RegionMap, RegionScales, TimelineWindow, TopologicalMap, WindowMap, software_versions
 from .settings import Settings, resolve
@@ -93,8 +95,14 @@ def map_encounters(
     config = (config or MapConfig()).validate()
     reader = reader or load_classifier(shipped_reader_for(log))
     settings = resolve(log, config, reader)
+    leash = leash_of(log)
+    exploring = leash is not None and config.timeline_length is None and config.timeline_step is None
+    # a beacon-led log's local maps are the timeline's windows, of a length set by the leader's speed
+    timeline_config = (replace(config, timeline_length=exploration_length(log, settings.window_length[0]))
+                       if exploring else config)
     # a timeline of its own windows, decided now: a step too small for the log is refused before any map work
-    timeline_spans = own_spans(config, settings.window_length[0], settings.times)
+    timeline_spans = own_spans(timeline_config, settings.window_length[0], settings.times,
+                               **({"cap": MAX_EXPLORATION_WINDOWS} if leash is not None else {}))
     rng = np.random.default_rng(config.seed)
     say = progress or (lambda stage: None)
     timings = dict.fromkeys(STAGES, 0.0)
@@ -136,9 +144,13 @@ def map_encounters(
         known = all(n in r.betti for r in regions)
         betti[n] = sum(r.betti[n] for r in regions) if known else None
         confidence[n] = reader.map_confidence([r.confidence.get(n) for r in regions], n) if known else None
-    length, step = timeline_settings(config, settings.window_length[0])
+    length, step = timeline_settings(timeline_config, settings.window_length[0])
     timeline = build_timeline(timeline_windows, length, step, betti, confidence, log,
-                              note=None if timeline_windows else no_timeline_note(config, length))
+                              note=None if timeline_windows else no_timeline_note(timeline_config, length))
+    exploration = None
+    if leash is not None and betti.get(1) is not None:  # the global map's counts are the answer
+        exploration = stitch(timeline.windows, log.beacon, leash, length, step, len(regions), log.meta)
+        betti[1], confidence[1] = exploration.betti[1], None
     return TopologicalMap(
         betti=betti,
         confidence=confidence,
@@ -156,11 +168,12 @@ def map_encounters(
         window_length=settings.window_length,
         windows_left_out=settings.windows_left_out,
         log_warnings=(silence_warnings(settings.times, settings.window_length[0]) + _extrapolation_warnings(betti)
-                      + _change_warnings(timeline)),
+                      + (exploration.warnings if exploration else _change_warnings(timeline))),
         beta0_evidence=split.beta0,
         contact_trace=len(log.status_t) == 0,
         software=software_versions(),
         timeline=timeline,
+        exploration=exploration,
     )
 
 

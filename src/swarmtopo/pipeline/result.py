@@ -165,6 +165,51 @@ class Timeline:
         return "; ".join(parts)
 
 
+@dataclass(frozen=True)
+class ExploredHole:
+    """A hole of the global map of a beacon-led log (:mod:`.exploration`): in the swarm's
+    view from ``t_in`` to ``t_out`` (s); its position (mm) estimated from where the leader
+    was meanwhile, within ``radius`` mm; ``open`` when it was already in view at the first
+    window or still in view at the last (its position is then less sure)."""
+
+    x: float
+    y: float
+    radius: float
+    t_in: float
+    t_out: float
+    windows: int
+    open: bool = False
+
+
+@dataclass(eq=False)
+class Exploration:
+    """The global map of a log with a leader's track (:mod:`.exploration`).
+
+    ``betti`` are the global counts: beta_0 the map's regions, beta_1 the holes seen
+    along the way, each counted once (``holes``).  ``windows`` are the local maps (the
+    timeline's windows) with the leader's position at their middle; ``coverage`` is the
+    area (mm^2) within the leash of the leader's path, the swarm's reach.
+    """
+
+    leash: float
+    leader_speed: float  # mm/s, mean while moving
+    length: float  # s, each local map's window
+    step: float
+    betti: dict[int, int]
+    holes: list[ExploredHole]
+    windows: list[TimelineWindow]
+    leader_xy: np.ndarray  # (K, 2) the leader at the middle of each window
+    path: np.ndarray  # (P, 2) the leader's track, its rows
+    coverage: float
+    warnings: list[str]
+
+    def summary(self) -> str:
+        """One line: the global counts and where the holes are."""
+        where = "; ".join(f"({h.x:.0f}, {h.y:.0f}) mm +- {h.radius:.0f}" for h in self.holes)
+        return (f"global map along the leader's path: beta_0 = {self.betti[0]}, beta_1 = {self.betti[1]}"
+                + (f"; holes at {where}" if where else "") + f" ({len(self.windows)} local maps)")
+
+
 @dataclass(eq=False)
 class TopologicalMap:
     """The result of mapping an encounter log.
@@ -196,6 +241,7 @@ class TopologicalMap:
     beta0_evidence: Beta0Evidence | None = None  # what beta_0's confidence was read from
     contact_trace: bool = False  # the log has no status changes: a contact trace
     timeline: Timeline | None = None  # Betti numbers over sliding windows, change points (pipeline.timeline)
+    exploration: Exploration | None = None  # the global map of a beacon-led log (pipeline.exploration)
 
     @property
     def warnings(self) -> list[str]:

@@ -252,9 +252,10 @@ def timeline_settings(config: MapConfig, window_length: float) -> tuple[float, f
     return length, length / 2 if step is None else step
 
 
-def own_spans(config: MapConfig, window_length: float, times: np.ndarray) -> list[tuple[float, float]] | None:
+def own_spans(config: MapConfig, window_length: float, times: np.ndarray, cap: int = MAX_TIMELINE_WINDOWS
+              ) -> list[tuple[float, float]] | None:
     """The windows of a timeline of its own length and step (``timeline_length`` or
-    ``timeline_step`` set) over the sorted event ``times``: at most ``MAX_TIMELINE_WINDOWS``,
+    ``timeline_step`` set) over the sorted event ``times``: at most ``cap``,
     evenly spaced, each holding ``min_region_events`` events (:func:`~.windows.scaled_windows`);
     None for the map's own windows."""
     if config.timeline_length is None and config.timeline_step is None:
@@ -262,7 +263,7 @@ def own_spans(config: MapConfig, window_length: float, times: np.ndarray) -> lis
     length, step = timeline_settings(config, window_length)
     if length == WHOLE_LOG:
         return []
-    spans, _ = scaled_windows(times, [length], step, MAX_TIMELINE_WINDOWS, config.min_region_events)
+    spans, _ = scaled_windows(times, [length], step, cap, config.min_region_events)
     return [span for span in spans if span is not None]
 
 

@@ -25,16 +25,19 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import shapely
 from numba.core.registry import CPUDispatcher
 
 from .. import __version__
 from .._validate import fraction, non_negative, positive, positive_int
 from ..arena import Arena
+from ..beacon import BeaconTrack
 from ..changing import ChangingArena
 from ..errors import InputError
 from .._json import jsonable
 from ..log import LOG_FORMAT, EncounterLog, state_labels
 from . import changes as _changes
+from . import leash as _leash
 from . import commands as _commands
 from . import motion as _motion
 from . import sensing as _sensing
@@ -94,6 +97,8 @@ def simulate(
     truth: bool = False,
     trajectory_every: float | None = None,
     progress: Callable[[float], None] | None = None,
+    beacon: BeaconTrack | None = None,
+    leash: float | None = None,
 ) -> Simulation:
     """Run the bio-inspired swarm model in ``arena`` and log encounters and status changes.
 
@@ -128,6 +133,10 @@ def simulate(
         of dt, at least dt).
     progress : callable or None
         Called with the fraction done (about 100 times).
+    beacon, leash : BeaconTrack and float, or None
+        A leader moving along ``beacon`` with agents kept within ``leash`` R mm of it
+        (:mod:`.leash`); both or neither.  The agents start uniformly in the free space
+        within R of the leader's first position, and ``log.beacon`` is its track up to t_K.
 
     Returns
     -------
@@ -143,6 +152,13 @@ def simulate(
     """
     _check_inputs(arena, n_agents, duration, dt, motion, sensing, commands, static_fraction, static_time,
                   trajectory_every, progress)
+    if (beacon is None) != (leash is None):
+        raise InputError("a leader needs both beacon= (its track) and leash= (R, mm)",
+                         value=f"beacon={beacon!r}, leash={leash!r}")
+    if beacon is not None:
+        if not isinstance(beacon, BeaconTrack):
+            raise InputError(f"beacon must be a BeaconTrack, got {type(beacon).__name__}")
+        leash = positive("leash", leash)
     commands = list(commands)
     if static_fraction > 0:
         commands.append(Command(static_time, "static", fraction=static_fraction))
@@ -161,7 +177,11 @@ def simulate(
     free = arena.at(0.0) if isinstance(arena, ChangingArena) else arena
     walls = _walls.build_wall_grid(free.boundary_segments, free.bounds, cell=r_d, reach=reach)
     model = _motion.make_model(motion, r_d, dt)
-    agents = _motion.new_swarm(free.sample_uniform(n, gen, clearance=_walls.WALL_EPS), model, gen)
+    start_area = None
+    if beacon is not None:
+        start_area = shapely.Point(*(float(c[0]) for c in beacon.position([0.0]))).buffer(leash, quad_segs=32)
+    agents = _motion.new_swarm(free.sample_uniform(n, gen, clearance=_walls.WALL_EPS, within=start_area), model, gen)
+    stimulated, stimulus = 0, np.zeros(n, np.bool_)
     tracker = _sensing.EncounterTracker(n, r_d, walls if sensing.walls_block else None,
                                         log_initial_contacts=sensing.log_initial_contacts)
     sample_every = None if trajectory_every is None else max(1, int(round(trajectory_every / dt)))
@@ -200,6 +220,9 @@ def simulate(
                 static_times.append(np.full(len(newly), t))
             _commands.apply_command(agents, model, walls, gen, targets, np.int8(cmd.mode))
             next_command += 1
+        if beacon is not None:
+            bx, by = beacon.position(t)
+            stimulated += _leash.steer(agents, stimulus, float(bx), float(by), leash, model, walls, gen)
         n_changed = _motion.step_swarm(agents, model, walls, gen, k < n_steps, changed)
         if n_changed:
             who = changed[:n_changed].copy()
@@ -213,7 +236,13 @@ def simulate(
     if isinstance(arena, ChangingArena):
         meta["simulation"]["betti_timeline"] = jsonable(arena.betti_timeline(meta["duration"]))
         meta["simulation"]["relocated"] = relocated
+    if beacon is not None:
+        meta["leash"] = leash  # the operator's setting, not ground truth: the map reads it
+        meta["simulation"]["leash"] = {"R": leash, "heading_error": _leash.HEADING_ERROR,
+                                       "stimulated_share": stimulated / (n * (n_steps + 1))}
     log, order = _build_log(events, status, static_agents, static_times, meta)
+    if beacon is not None:
+        log = dataclasses.replace(log, beacon=beacon.clipped(meta["duration"]))
     return Simulation(
         log=log,
         truth=_truth(events, order) if truth else None,
@@ -388,7 +417,7 @@ def interpreted_kernels():
     Python source function, so a simulation is a plain per-agent Python loop of the
     same model with the same neighbour search.  Not thread-safe.
     """
-    modules = [_walls, _motion, _commands, _sensing]
+    modules = [_walls, _motion, _commands, _sensing, _leash]
     saved = []
     for module in modules:
         for name, obj in vars(module).items():

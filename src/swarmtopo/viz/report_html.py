@@ -101,6 +101,7 @@ def report_html(tmap: TopologicalMap, *, log: EncounterLog, truth: dict | None =
     figures: dict[str, dict] = {}
     sections = [
         _verdict_section(doc, None if true_timeline else arena, true_timeline),
+        _exploration_section(doc, figures, arena),
         _timeline_section(doc, figures, true_timeline),
         _persistence_section(tmap, doc, figures),
         _cloud_section(tmap, log, truth, arena, figures),
@@ -173,7 +174,10 @@ def _verdict_section(doc: dict, arena, true_timeline: list | None = None) -> str
         items.append(f'<span class="betti" data-dim="{n}" data-value="{shown}">&beta;<sub>{n}</sub> = {shown}</span>'
                      f" ({conf_html})")
     lines = [f'<p class="betti-line">{" &nbsp;&middot;&nbsp; ".join(items)}</p>']
-    if timeline.get("changes"):
+    if doc.get("exploration"):
+        lines.insert(0, f'<p class="explored">{html.escape(doc["exploration"]["summary"])} '
+                        '(<a href="#exploration">exploration</a>):</p>')
+    elif timeline.get("changes"):
         lines.insert(0, f'<p class="changed">the arena changed: {html.escape(timeline["summary"])} '
                         '(<a href="#timeline">timeline</a>); pooled over the whole log:</p>')
     if true_timeline:
@@ -197,6 +201,62 @@ def _verdict_section(doc: dict, arena, true_timeline: list | None = None) -> str
     if len(doc["regions"]) > 1:
         lines.append(_regions_table(doc))
     return f'<section id="verdict"><h2>Verdict</h2>\n{"".join(lines)}</section>\n'
+
+
+def _exploration_section(doc: dict, figures: dict, arena) -> str:
+    """A beacon-led log's global map: the leader's path, the area within its leash, the
+    local maps' counts where the leader was, and each hole's estimated position."""
+    found = doc.get("exploration")
+    if not found:
+        return ""
+    figures["plot-exploration"] = _exploration_figure(found, arena)
+    rows = "".join(f'<tr><td>{i}</td><td class="num">({h["x"]:.0f}, {h["y"]:.0f}) mm</td>'
+                   f'<td class="num">{h["radius"]:.0f} mm</td><td class="num">{h["in_view"][0]:.0f}-'
+                   f'{h["in_view"][1]:.0f} s</td><td class="num">{h["windows"]}</td>'
+                   f'<td>{"at an end of the path" if h["open"] else ""}</td></tr>'
+                   for i, h in enumerate(found["holes"], 1))
+    table = ("<table><tr><th>hole</th><th>estimated position</th><th>within</th><th>in view</th><th>local maps</th>"
+             f"<th></th></tr>{rows}</table>") if rows else '<p class="note">No hole was seen along the path.</p>'
+    return ('<section id="exploration"><h2>Exploration: the global map</h2>\n'
+            f'<p class="note">A leader moved at {found["leader_speed"]:.3g} mm/s with the swarm on a leash of '
+            f'R = {found["leash"]:g} mm; {len(found["windows"])} local maps of {found["length"]:.3g} s each (every '
+            f'{found["step"]:.3g} s) counted the holes in the swarm\'s view. A hole is counted once, from when it came '
+            "into view to when it left, and placed on the leader's path halfway between (docs/exploration.md). "
+            f'Shaded: within R of the leader at its local maps (within R of its whole path: '
+            f'{found["coverage_mm2"] / 1e6:.2f} m&sup2;), what the swarm can have seen'
+            f'{"; grey: the true arena" if arena is not None else ""}.</p>{table}'
+            '<div id="plot-exploration" class="plot" style="height:520px"></div></section>\n')
+
+
+def _exploration_figure(found: dict, arena) -> dict:
+    import shapely
+
+    data = _arena_traces(arena) if arena is not None else []
+    path = np.asarray([w["leader"] for w in found["windows"]], dtype=float).reshape(-1, 2)
+    if len(path):
+        line = shapely.LineString(path) if len(np.unique(path, axis=0)) > 1 else shapely.Point(path[0])
+        for poly in getattr(area := line.buffer(found["leash"]), "geoms", [area]):
+            x, y = poly.exterior.xy
+            data.append({"type": "scatter", "x": _floats(x, 1), "y": _floats(y, 1), "fill": "toself", "mode": "lines",
+                         "fillcolor": "rgba(31,119,180,0.12)", "line": {"color": "rgba(31,119,180,0.4)", "width": 1},
+                         "name": "within the leash of the path", "hoverinfo": "skip"})
+        data.append({"type": "scatter", "mode": "lines+markers", "x": _floats(path[:, 0], 1),
+                     "y": _floats(path[:, 1], 1), "name": "leader at each local map",
+                     "line": {"color": "#1f77b4", "width": 2},
+                     "marker": {"color": [w["beta_1"] for w in found["windows"]], "colorscale": "Viridis", "size": 7,
+                                "colorbar": {"title": {"text": "holes in view"}, "len": 0.6}},
+                     "text": [f'{w["t0"]:.0f}-{w["t1"]:.0f} s: {w["beta_1"]} hole(s) in view' for w in found["windows"]],
+                     "hovertemplate": "%{text}<extra></extra>"})
+    theta = np.linspace(0, 2 * np.pi, 65)
+    for i, h in enumerate(found["holes"], 1):
+        color = _LOOP_COLORS[(i - 1) % len(_LOOP_COLORS)]
+        data.append({"type": "scatter", "mode": "lines", "x": _floats(h["x"] + h["radius"] * np.cos(theta), 1),
+                     "y": _floats(h["y"] + h["radius"] * np.sin(theta), 1), "line": {"color": color, "dash": "dot"},
+                     "name": f"hole {i}: within {h['radius']:.0f} mm", "hoverinfo": "skip"})
+        data.append({"type": "scatter", "mode": "markers", "x": [h["x"]], "y": [h["y"]], "name": f"hole {i}",
+                     "marker": {"color": color, "size": 14, "symbol": "x", "line": {"color": "black", "width": 1}},
+                     "hovertemplate": f"hole {i} at (%{{x:.0f}}, %{{y:.0f}}) mm<extra></extra>"})
+    return {"data": data, "layout": _plane_layout(arena, 520), "config": {"displaylogo": False, "responsive": True}}
 
 
 def _timeline_section(doc: dict, figures: dict, true_timeline: list | None) -> str:

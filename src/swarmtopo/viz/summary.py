@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from .._json import jsonable
-from ..pipeline.result import RegionMap, Timeline, TopologicalMap, WindowMap
+from ..pipeline.result import Exploration, RegionMap, Timeline, TopologicalMap, WindowMap
 from ..readers.beta0 import BETA0_DEFINITION
 from ..readers.ratio import RESOLUTION_CAP, below_full_resolution, resolution
 from .text import format_confidence
@@ -70,6 +70,7 @@ def map_json(tmap: TopologicalMap) -> dict[str, Any]:
         "regions": [_region_json(r) for r in tmap.regions],
         "too_little_data": tmap.too_little_data,
         "timeline": None if tmap.timeline is None else timeline_json(tmap.timeline),
+        "exploration": None if tmap.exploration is None else exploration_json(tmap.exploration),
         "beta0_evidence": None if tmap.beta0_evidence is None else {**tmap.beta0_evidence.to_json(),
                                                                       "definition": BETA0_DEFINITION},
         "params": {**jsonable(asdict(tmap.config)), "hop_cost_used": tmap.hop_cost[0],
@@ -100,6 +101,20 @@ def timeline_json(timeline: Timeline) -> dict[str, Any]:
                      for n, segs in sorted(timeline.segments.items())},
         "changes": [{"dimension": c.dim, "t": c.t, "from": c.before, "to": c.after, "interval": [c.lo, c.hi],
                      "confidence": number(c.confidence)} for c in timeline.changes],
+    }
+
+
+def exploration_json(exploration: Exploration) -> dict[str, Any]:
+    """map.json's ``exploration``: the global map of a beacon-led log."""
+    return {
+        "summary": exploration.summary(), "leash": exploration.leash, "leader_speed": exploration.leader_speed,
+        "length": exploration.length, "step": exploration.step, "coverage_mm2": exploration.coverage,
+        "betti": {str(n): b for n, b in sorted(exploration.betti.items())},
+        "holes": [{"x": h.x, "y": h.y, "radius": h.radius, "in_view": [h.t_in, h.t_out], "windows": h.windows,
+                   "open": h.open} for h in exploration.holes],
+        "windows": [{"t0": w.t0, "t1": w.t1, "beta_1": w.betti[1], "leader": [float(x), float(y)]}
+                    for w, (x, y) in zip(exploration.windows, exploration.leader_xy)],
+        "warnings": exploration.warnings,
     }
 
 
