@@ -19,14 +19,14 @@ import pickle
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
-import shapely
 
 from swarmtopo.beacon import long_axis_track
 from swarmtopo.experiments.exploration import CELLS, jobs
 from swarmtopo.experiments.grid import job_simulation_args
 from swarmtopo.experiments.sweep import build_arena, stripped_log
 from swarmtopo.pipeline import MapConfig, map_encounters
-from swarmtopo.pipeline.exploration import leader_speed, stitch
+from swarmtopo.pipeline import exploration
+from swarmtopo.pipeline.exploration import stitch
 from swarmtopo.sim import simulate
 
 
@@ -38,23 +38,22 @@ def local_maps(job, travels):
     track = long_axis_track(arena.bounds, swarm["leash"], swarm["leader_speed"])
     sim = simulate(arena, **job_simulation_args(swarm), beacon=track, leash=swarm["leash"], rng=seeds["simulation"])
     log = stripped_log(sim.log)
-    true = [shapely.Polygon(ring).centroid for region in arena.regions for ring in region.interiors]
     out = []
-    for travel in travels:
-        length = travel * swarm["leash"] / leader_speed(log.beacon)
-        tmap = map_encounters(log, MapConfig(embed_dim=0, cycles=False, seed=seeds["map"] % 2**32,
-                                             timeline_length=max(length, 1.0)))
+    for travel in travels:  # the shipped map, its local maps' travel set to each value in turn
+        exploration.EXPLORATION_TRAVEL = travel
+        tmap = map_encounters(log, MapConfig(embed_dim=0, cycles=False, seed=seeds["map"] % 2**32))
         found = tmap.exploration
-        out.append((travel, found.windows, log.beacon, found.leash, found.length, found.step))
-    return [(p.x, p.y) for p in true], out
+        span = (float(log.t[0]), float(log.t[-1]))
+        out.append((travel, found.windows, log.beacon, found.leash, found.length, found.step, span))
+    return arena.hole_centroids().tolist(), out
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--per-cell", type=int, default=3)
-    parser.add_argument("--travel", type=float, nargs="+", default=[0.2, 0.4])
-    parser.add_argument("--penalties", type=float, nargs="+", default=[1.5, 2.0, 2.5, 3.0, 4.0])
-    parser.add_argument("--handovers", type=float, nargs="+", default=[1.2])
+    parser.add_argument("--travel", type=float, nargs="+", default=[exploration.EXPLORATION_TRAVEL])
+    parser.add_argument("--penalties", type=float, nargs="+", default=[exploration.EXPLORATION_PENALTY])
+    parser.add_argument("--handovers", type=float, nargs="+", default=[exploration.HANDOVER_TRAVEL])
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--verbose", action="store_true", help="each case's local counts")
     parser.add_argument("--save", help="pickle the local maps here (to study them again without mapping)")
@@ -74,19 +73,18 @@ def main() -> None:
     print("|---|---|---|---|---|---|")
     for (t_index, travel), penalty, handover in itertools.product(enumerate(args.travel), args.penalties,
                                                                    args.handovers):
-        if True:
-            exact, errors = 0, []
-            for true, maps in cases:
-                _, windows, track, leash, length, step = maps[t_index]
-                found = stitch(windows, track, leash, length, step, 1, {}, penalty=penalty, handover=handover)
-                exact += found.betti[1] == len(true)
-                if args.verbose:
-                    print(f"  travel {travel:g} penalty {penalty:g}: {len(true)} holes, found {found.betti[1]}: "
-                          + " ".join(str(w.betti[1]) for w in windows))
-                xy = np.asarray(true)
-                errors += [float(np.hypot(*(xy - (h.x, h.y)).T).min()) for h in found.holes]
-            print(f"| {travel:g} | {penalty:g} | {handover:g} | {exact}/{len(cases)} | {np.median(errors):.0f} mm | "
-                  f"{np.percentile(errors, 90):.0f} mm |")
+        exact, errors = 0, []
+        for true, maps in cases:
+            _, windows, track, leash, length, step, span = maps[t_index]
+            found = stitch(windows, track, leash, length, step, 1, {}, span, penalty=penalty, handover=handover)
+            exact += found.betti[1] == len(true)
+            if args.verbose:
+                print(f"  travel {travel:g} penalty {penalty:g}: {len(true)} holes, found {found.betti[1]}: "
+                      + " ".join(str(w.betti[1]) for w in windows))
+            xy = np.asarray(true)
+            errors += [float(np.hypot(*(xy - (h.x, h.y)).T).min()) for h in found.holes]
+        print(f"| {travel:g} | {penalty:g} | {handover:g} | {exact}/{len(cases)} | {np.median(errors):.0f} mm | "
+              f"{np.percentile(errors, 90):.0f} mm |")
 
 
 if __name__ == "__main__":

@@ -12,7 +12,7 @@ from swarmtopo.experiments.exploration import CELLS, case_config, records, table
 from swarmtopo.io import read_log, strip_ground_truth, write_log
 from swarmtopo.io.beacons import read_beacon_path
 from swarmtopo.pipeline import MapConfig, map_encounters
-from swarmtopo.pipeline.exploration import REVISIT_FRACTION, leader_speed, stitch
+from swarmtopo.pipeline.exploration import leader_speed, stitch
 from swarmtopo.pipeline.result import TimelineWindow
 from swarmtopo.sim import simulate
 from swarmtopo.sim.leash import HEADING_ERROR
@@ -25,9 +25,9 @@ def test_a_track_is_linear_between_rows_and_held_outside_them():
     x, y = track.position([0.0, 15.0, 30.0, 99.0])
     assert x.tolist() == [0.0, 50.0, 100.0, 100.0] and y.tolist() == [0.0, 0.0, 100.0, 200.0]
     assert track.distance_travelled(15.0, 30.0) == pytest.approx(50.0 + 100.0)
-    assert track.speed() == pytest.approx(10.0)
-    clipped = track.clipped(30.0)
-    assert clipped.t.tolist() == [10.0, 20.0, 30.0] and clipped.y.tolist() == [0.0, 0.0, 100.0]
+    cut = track.between(15.0, 30.0)
+    assert cut.t.tolist() == [15.0, 20.0, 30.0] and cut.x.tolist() == [50.0, 100.0, 100.0]
+    assert cut.y.tolist() == [0.0, 0.0, 100.0] and track.between(0.0, 5.0).x.tolist() == [0.0, 0.0]
 
 
 @pytest.mark.parametrize("t, x, column, row", [
@@ -133,8 +133,9 @@ def test_a_leader_run_is_reproducible_and_the_interpreted_kernels_agree():
     with interpreted_kernels():
         runs.append(simulate(arena, 30, 20.0, rng=7, beacon=track, leash=150.0))
     for other in runs[1:]:
-        assert np.array_equal(runs[0].log.t, other.log.t) and np.array_equal(runs[0].log.a, other.log.a)
-        assert np.array_equal(runs[0].log.beacon.x, other.log.beacon.x)
+        for name in ("t", "a", "b", "status_t", "status_agent", "status_state"):
+            assert np.array_equal(getattr(runs[0].log, name), getattr(other.log, name)), name
+    assert runs[0].log.n_events > 0 and runs[0].log.meta["simulation"]["leash"]["stimulated_share"] > 0
 
 
 def test_a_leader_needs_both_its_track_and_its_leash():
@@ -167,13 +168,16 @@ def _windows(counts, length=20.0):
                            confidence={0: 0.99, 1: 0.9}) for k, c in enumerate(counts)]
 
 
+SPAN = (0.0, 1000.0)
+
+
 def _straight(speed=2.0, end=1000.0):
     return BeaconTrack.from_columns([0.0, end], [0.0, speed * end], [0.0, 0.0])
 
 
 def test_a_hole_is_placed_a_leash_behind_where_the_leader_was_when_it_left_the_view():
     counts = [0] * 10 + [1] * 12 + [0] * 10
-    found = stitch(_windows(counts), _straight(), 200.0, 20.0, 10.0, 1, {})
+    found = stitch(_windows(counts), _straight(), 200.0, 20.0, 10.0, 1, {}, SPAN)
     (hole,) = found.holes
     # the count rises between window 9 ([90, 110]) and window 10 ([100, 120]): t = (90 + 120) / 2 = 105 s,
     # and falls between window 21 ([210, 230]) and window 22 ([220, 240]): t = (210 + 240) / 2 = 225 s
@@ -185,35 +189,43 @@ def test_a_hole_is_placed_a_leash_behind_where_the_leader_was_when_it_left_the_v
 
 def test_a_count_that_stays_one_for_two_holes_travels_is_two_holes_handed_over():
     counts = [0] * 10 + [1] * 26 + [0] * 10  # in view from 105 to 365 s: 520 mm, twice 1.3 x 200 mm
-    first, second = stitch(_windows(counts), _straight(), 200.0, 20.0, 10.0, 1, {}).holes
+    first, second = stitch(_windows(counts), _straight(), 200.0, 20.0, 10.0, 1, {}, SPAN).holes
     assert (first.t_in, first.t_out, second.t_in, second.t_out) == (105.0, 235.0, 235.0, 365.0)
     assert first.x == pytest.approx(2.0 * 235.0 - 200.0) and second.x == pytest.approx(2.0 * 365.0 - 200.0)
-    assert len(stitch(_windows(counts), _straight(), 200.0, 20.0, 10.0, 1, {}, handover=2.0).holes) == 1
+    assert len(stitch(_windows(counts), _straight(), 200.0, 20.0, 10.0, 1, {}, SPAN, handover=2.0).holes) == 1
+    fast = stitch(_windows([0] * 10 + [1] * 6 + [0] * 10), _straight(speed=50.0), 200.0, 20.0, 10.0, 1, {}, SPAN)
+    assert len(fast.holes) == 6  # 50 mm/s over 6 windows is 11 hand-over travels: no more holes than windows
 
 
 def test_holes_in_view_together_leave_first_in_first_out():
     counts = [0] * 8 + [1] * 8 + [2] * 8 + [1] * 8 + [0] * 8
-    found = stitch(_windows(counts), _straight(), 100.0, 20.0, 10.0, 1, {})
+    found = stitch(_windows(counts), _straight(), 100.0, 20.0, 10.0, 1, {}, SPAN)
     first, second = found.holes
     assert first.t_in < second.t_in and first.t_out < second.t_out
     assert first.x < second.x
 
 
 def test_a_misread_window_is_not_a_hole_and_a_revisit_is_one_hole():
-    assert stitch(_windows([0] * 10 + [1] + [0] * 10), _straight(), 100.0, 20.0, 10.0, 1, {}).holes == []
+    assert stitch(_windows([0] * 10 + [1] + [0] * 10), _straight(), 100.0, 20.0, 10.0, 1, {}, SPAN).holes == []
     there_and_back = BeaconTrack.from_columns([0.0, 250.0, 500.0], [0.0, 500.0, 0.0], [0.0, 0.0, 0.0])
     counts = [0] * 8 + [1] * 8 + [0] * 18 + [1] * 8 + [0] * 7  # out past it and back past it
-    found = stitch(_windows(counts), there_and_back, 400.0, 20.0, 10.0, 1, {})
+    found = stitch(_windows(counts), there_and_back, 400.0, 20.0, 10.0, 1, {}, (0.0, 500.0))
     assert len(found.holes) == 1 and found.holes[0].windows >= 16
-    assert REVISIT_FRACTION * 400.0 > 0
+    pieces = stitch(_windows(counts), there_and_back, 400.0, 20.0, 10.0, 1, {}, (0.0, 500.0), handover=0.1)
+    assert [h.windows for h in pieces.holes] == [16]  # one window per hand-over, at most, all merged back
 
 
 def test_warnings_name_a_fast_leader_and_a_stretch_without_local_maps():
     windows = _windows([0] * 10) + [TimelineWindow(t0=400.0, t1=420.0, n_events=500, betti={0: 1, 1: 0},
                                                    confidence={0: 0.99, 1: 0.9})]
-    found = stitch(windows, _straight(speed=10.0, end=500.0), 100.0, 20.0, 10.0, 1, {"v_c": 15.0})
+    found = stitch(windows, _straight(speed=10.0, end=500.0), 100.0, 20.0, 10.0, 1, {"v_c": 15.0}, (0.0, 420.0))
     assert any("faster than" in w for w in found.warnings)
     assert any(w.startswith("no local map from 110 to 400 s") for w in found.warnings)
+    late = stitch(_windows([0] * 10), BeaconTrack.from_columns([200.0, 300.0], [0.0, 100.0], [0.0, 0.0]), 100.0,
+                  20.0, 10.0, 1, {}, (0.0, 110.0))
+    assert late.leader_speed == 0.0 and late.warnings[0].startswith("the leader's track (beacon.csv) runs from 200")
+    few = stitch(_windows([1] * 5), _straight(), 100.0, 20.0, 10.0, 1, {}, SPAN)
+    assert few.betti[1] is None and few.holes == [] and "no global count" in few.warnings[0]
 
 
 # -- the whole map ---------------------------------------------------------------------------
@@ -244,6 +256,26 @@ def test_a_log_without_a_leader_has_no_exploration():
     assert map_encounters(sim.log, MapConfig(embed_dim=0, cycles=False)).exploration is None
 
 
+def test_a_leader_that_never_moves_keeps_the_pooled_answer():
+    """One local map (the paper's whole-log window) is no global map: the pooled count stays, with its reason."""
+    from dataclasses import replace
+
+    from swarmtopo.pipeline import config_from_options
+    from swarmtopo.pipeline.config import PAPER_OPTIONS
+
+    sim = simulate(square_arena(), 150, 30.0, rng=1, beacon=BeaconTrack.from_columns([0.0], [250.0], [250.0]),
+                   leash=300.0)
+    config = replace(config_from_options(PAPER_OPTIONS), embed_dim=0, cycles=False)
+    without = {k: v for k, v in sim.log.meta.items() if k != "leash"}
+    pooled = map_encounters(replace(sim.log, beacon=None, meta=without), config)
+    tmap = map_encounters(sim.log, config)
+    assert tmap.exploration.betti[1] is None and tmap.betti == pooled.betti and tmap.confidence == pooled.confidence
+    assert any("no global count" in w for w in tmap.warnings)
+    assert map_json(tmap)["exploration"]["length"] is None
+    half = map_encounters(replace(sim.log, beacon=None), MapConfig(embed_dim=0, cycles=False))
+    assert any("a 'leash' in meta.json but no beacon.csv" in w for w in half.warnings)
+
+
 def test_simulate_and_map_from_the_command_line(explored, tmp_path):
     from conftest import run_cli
 
@@ -251,7 +283,7 @@ def test_simulate_and_map_from_the_command_line(explored, tmp_path):
     done = run_cli("simulate", "--arena", str(folder / "log" / "arena.geojson"), "--beacon", "sweep", "--leash", "250",
                    "--agents", "200", "--duration", "400", "--seed", "3", "--out", str(tmp_path / "log"))
     assert done.returncode == 0, done.stderr
-    assert "a leader moved 740 mm" in done.stdout  # 2 mm/s from 30 s to 400 s and (tmp_path / "log" / "beacon.csv").exists()
+    assert "a leader moved 740 mm" in done.stdout and (tmp_path / "log" / "beacon.csv").exists()  # 2 mm/s from 30 s to 400 s
     assert "the leader's track runs to" in done.stderr  # 30 + 900 / 2 s > 400 s
     done = run_cli("map", str(tmp_path / "log"), "--out", str(tmp_path / "map"))
     assert done.returncode == 0, done.stderr
@@ -260,6 +292,9 @@ def test_simulate_and_map_from_the_command_line(explored, tmp_path):
     assert '<section id="exploration">' in page and 'data-target="plot-exploration"' in page
     bad = run_cli("simulate", "--beacon", "sweep", "--out", str(tmp_path / "x"))
     assert bad.returncode == 2 and "--leash" in bad.stderr
+    bad = run_cli("simulate", "--beacon", str(tmp_path / "log" / "beacon.csv"), "--leash", "250", "--leader-speed", "3",
+                  "--out", str(tmp_path / "x"))
+    assert bad.returncode == 2 and "--leader-speed" in bad.stderr
 
 
 # -- the benchmark ---------------------------------------------------------------------------
@@ -307,3 +342,34 @@ def test_a_sweep_job_with_a_leader_maps_a_hall_and_stores_its_global_map():
     with pytest.raises(InputError, match="leader_speed.*not used: leash is 0"):
         expand_grid({"swarm": {"leader_speed": 3.0}})
     assert "leash" not in expand_grid({"swarm": {"leash": 0.0}}).jobs[0].config["swarm"]  # no leader: jobs as before
+
+
+def test_the_sweep_record_of_a_changing_arena_gives_its_holes_at_the_start():
+    from swarmtopo.changing import changing_arena
+    from swarmtopo.experiments.sweep import exploration_record
+
+    arena = changing_arena("appear", 1, 60.0, rng=0)
+    found = stitch(_windows([0] * 8), _straight(), 100.0, 20.0, 10.0, 1, {}, SPAN)
+    record = exploration_record(found, arena, "map")
+    assert record["true_holes"] == arena.at(0.0).hole_centroids().tolist() and len(record["true_holes"]) == 1
+    assert "windows" not in record and "windows" in exploration_record(found, arena, "windows")
+
+
+@pytest.mark.parametrize("bad, message", [
+    ({"type": "FeatureCollection", "features": 5}, "must be a list"),
+    ({"type": "Feature", "properties": {"speed": 1, "units": ["m"]},
+      "geometry": {"type": "LineString", "coordinates": [[0, 0], [1, 0]]}}, "units"),
+    ({"type": "Feature", "properties": {"speed": -0.5, "units": "cm"},
+      "geometry": {"type": "LineString", "coordinates": [[0, 0], [1, 0]]}}, "speed"),
+])
+def test_a_bad_path_file_is_one_line_naming_it(tmp_path, bad, message):
+    path = tmp_path / "path.geojson"
+    path.write_text(json.dumps(bad))
+    with pytest.raises(InputError, match=message) as info:
+        read_beacon_path(path)
+    assert info.value.file == str(path) and "\n" not in str(info.value)
+
+
+def test_a_leader_out_of_reach_of_the_arena_is_refused():
+    with pytest.raises(InputError, match="not within the leash"):
+        simulate(square_arena(), 5, 1.0, beacon=BeaconTrack.from_columns([0.0], [5000.0], [5000.0]), leash=100.0)

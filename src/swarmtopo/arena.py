@@ -147,6 +147,11 @@ class Arena:
             out = np.vstack([out, cand[keep]])
         return out[:n]
 
+    def hole_centroids(self) -> np.ndarray:
+        """(k, 2) centroids (mm) of the holes, region by region."""
+        points = [Polygon(ring).centroid for region in self.regions for ring in region.interiors]
+        return np.array([[p.x, p.y] for p in points]).reshape(-1, 2)
+
     def narrow_passages(self, width: float) -> list[str]:
         """The passages narrower than ``width`` (mm) between a hole and its outer wall or
         another hole of its region, described ("region 0: hole 1 is 15 mm from the outer

@@ -61,13 +61,12 @@ class BeaconTrack:
         t = np.asarray(t, dtype=np.float64)
         return np.interp(t, self.t, self.x), np.interp(t, self.t, self.y)
 
-    def clipped(self, end: float) -> "BeaconTrack":
-        """The track on [0, end]: its rows up to ``end`` and, when it goes on, its position at ``end``."""
-        keep = self.t <= end
-        t, x, y = self.t[keep], self.x[keep], self.y[keep]
-        if not len(t) or t[-1] < end:
-            ex, ey = self.position(end)
-            t, x, y = np.r_[t, end], np.r_[x, ex], np.r_[y, ey]
+    def between(self, start: float, end: float) -> "BeaconTrack":
+        """The track on [start, end] (start <= end): its rows inside, and its positions at
+        ``start`` and ``end`` (held before its first row and after its last)."""
+        inside = (self.t > start) & (self.t < end)
+        t = np.r_[start, self.t[inside], end] if end > start else np.array([start])
+        x, y = self.position(t)
         return BeaconTrack(t, x, y)
 
     def distance_travelled(self, t0: float, t1: float) -> float:
@@ -76,12 +75,6 @@ class BeaconTrack:
         ts = np.r_[t0, self.t[inside], t1]
         x, y = self.position(ts)
         return float(np.hypot(np.diff(x), np.diff(y)).sum())
-
-    def speed(self) -> float:
-        """The leader's largest speed between two rows, mm/s (0 for one row)."""
-        if len(self.t) < 2:
-            return 0.0
-        return float((np.hypot(np.diff(self.x), np.diff(self.y)) / np.diff(self.t)).max())
 
     def __len__(self) -> int:
         return len(self.t)

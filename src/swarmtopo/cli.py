@@ -204,8 +204,8 @@ def simulate(
              "from it are steered back; the log gains beacon.csv (docs/exploration.md in the source repository)."),
     leash: Optional[float] = typer.Option(None, "--leash", callback=_positive_option,
                                           help="Leash R (mm) of --beacon: agents farther are steered towards it."),
-    leader_speed: float = typer.Option(2.0, "--leader-speed", callback=_positive_option,
-                                       help="Speed (mm/s) of the leader of --beacon sweep (default 2)."),
+    leader_speed: Optional[float] = typer.Option(None, "--leader-speed", callback=_positive_option,
+                                                 help="Speed (mm/s) of the leader of --beacon sweep (default 2)."),
     overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar, no summary."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
@@ -232,6 +232,9 @@ def simulate(
     _check_option("--static-time", check_static_time, static_fraction, static_time, duration, dt)
     if (beacon is None) != (leash is None):
         raise typer.BadParameter("a leader needs both --beacon and --leash", param_hint="--beacon" if leash else "--leash")
+    if leader_speed is not None and beacon != "sweep":
+        raise typer.BadParameter("sets the speed of --beacon sweep only (a path file gives its own speed)",
+                                 param_hint="--leader-speed")
 
     if arena:  # scaled like a sweep's file arena
         world = read_arena(arena) if scale == 1.0 else read_arena(arena).scaled(scale)
@@ -272,17 +275,18 @@ def simulate(
         if leader:
             share = sim.log.meta["simulation"]["leash"]["stimulated_share"]
             out.print(f"a leader moved {leader['beacon'].distance_travelled(0.0, sim.log.meta['duration']):.0f} mm; "
-                      f"agents were beyond the leash R = {leash:g} mm (and steered back) {100 * share:.1f} % of the "
-                      "time", markup=False, highlight=False, soft_wrap=True)
+                      f"agents were steered back towards it (having gone beyond the leash R = {leash:g} mm) "
+                      f"{100 * share:.1f} % of the time", markup=False, highlight=False, soft_wrap=True)
         out.print(f"wrote {', '.join(str(p) for p in written)}", markup=False, highlight=False, soft_wrap=True)
 
 
 def _leader_track(beacon: str, world, leash: float, speed: float, duration: float, quiet: bool):
     """The leader's track of ``simulate --beacon``: a file's, or ``sweep`` along the arena's long axis."""
-    from .beacon import long_axis_track
+    from .beacon import LEADER_SPEED, long_axis_track
     from .io.beacons import read_beacon_path
 
-    track = (long_axis_track(world.bounds, leash, speed) if beacon == "sweep" else read_beacon_path(Path(beacon)))
+    track = (long_axis_track(world.bounds, leash, speed or LEADER_SPEED) if beacon == "sweep"
+             else read_beacon_path(Path(beacon)))
     if track.t[-1] > duration:
         _warn(f"the leader's track runs to t = {track.t[-1]:g} s, after the log ends at {duration:g} s: the "
               "swarm explores only part of it (give a longer --duration)", quiet)
@@ -498,7 +502,7 @@ def demo(
                                        "the map's timeline says when."),
     beacon: bool = typer.Option(False, "--beacon",
                                 help="A 2.4 m hall, bigger than the swarm sees at once, explored behind a leader: 300 "
-                                     "agents on a 300 mm leash, the leader sweeping the hall at 2 mm/s (about 13 "
+                                     "agents on a 300 mm leash, the leader sweeping the hall at 2 mm/s (about 16 "
                                      "minutes of log); the map stitches its local maps into a global one."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
@@ -1056,7 +1060,8 @@ def _print_verdict(tmap, truth) -> None:
                     f"beta_{n} not estimated (the classifier has no threshold for it)"
                     for n, b in sorted(tmap.betti.items()))
     timeline = tmap.timeline
-    if tmap.exploration is not None:  # its timeline's changes are holes coming into the swarm's view and leaving it
+    if tmap.exploration is not None and tmap.exploration.betti[1] is not None:  # its timeline's changes are holes
+        # coming into the swarm's view and leaving it
         found = tmap.exploration
         say(f"recovered: {est} (global map along the leader's path: {len(found.windows)} local maps, each hole "
             "counted once; its confidence is not calibrated)")

@@ -337,6 +337,20 @@ def rate_text(rate: dict[str, Any]) -> str:
     return f"{rate['right']}/{rate['total']} = {rate['rate']:.2f} [{lo:.2f}, {hi:.2f}]"
 
 
+def percent_text(rate: dict[str, Any]) -> str:
+    """A rate as a table cell, "rate % (k/n)" ("–" for none); ``Rate.to_json`` form."""
+    return "–" if rate["rate"] is None else f"{100 * rate['rate']:.0f} % ({rate['right']}/{rate['total']})"
+
+
+def failures_text(records: list[dict[str, Any]], outcome: str) -> list[str]:
+    """Markdown lines naming the records of maps that failed (none: no line); they count as ``outcome``."""
+    failed = [r for r in records if r["status"] != "ok"]
+    if not failed:
+        return []
+    return ["", f"{len(failed)} map(s) failed and count as {outcome}:",
+            *(f"- {r['cell']} case {r['index']}: {r['status']}: {r['error']}" for r in failed)]
+
+
 RELIABILITY_EDGES = (0.0, 0.5, 0.7, 0.8, 0.9, 0.95, 0.99, 1.0)
 """Confidence bins of the reliability table: narrow near 1, where most maps are reported."""
 

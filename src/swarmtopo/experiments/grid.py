@@ -94,6 +94,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..arena import HOLE_SHAPES, OUTER_SHAPES
+from ..beacon import LEADER_SPEED
 from ..changing import CHANGES
 from ..readers.registry import PRESETS, load_classifier
 from ..errors import InputError, SwarmtopoError
@@ -216,7 +217,7 @@ PARAMS: tuple[Param, ...] = (
     Param("swarm", "static_fraction", 0.0, _number(0.0, strict=False, hi=1.0), "DOUBLE"),
     Param("swarm", "static_time", 0.0, _number(0.0, strict=False), "DOUBLE"),
     Param("swarm", "leash", 0.0, _number(0.0, strict=False), "DOUBLE"),
-    Param("swarm", "leader_speed", 2.0, _number(0.0, strict=True), "DOUBLE"),
+    Param("swarm", "leader_speed", LEADER_SPEED, _number(0.0, strict=True), "DOUBLE"),
     *(Param("map", name, default, _option(name), sql) for name, default, sql in (
         ("metric", "hybrid", "TEXT"), ("hop_cost", "auto", "DOUBLE"), ("diffusion_time", "auto", "DOUBLE"),
         ("wall_follow_weight", MapConfig().wall_follow_weight, "DOUBLE"), ("window_length", "auto", "DOUBLE"),

@@ -34,8 +34,6 @@ from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from typing import Any, Callable, Iterable
 
-import shapely
-
 from ..arena import Arena, annulus_arena, default_arena, hall_arena, random_arena, square_arena, two_rooms_arena
 from ..beacon import long_axis_track
 from ..changing import ChangingArena, betti_timeline_of, changing_arena
@@ -238,12 +236,13 @@ def timeline_record(timeline, truth: list[dict[str, Any]], keep: str) -> dict[st
 
 def exploration_record(exploration, arena, keep: str) -> dict[str, Any]:
     """A row's ``exploration`` column: the global map (:func:`~swarmtopo.viz.summary.exploration_json`;
-    its local maps only at ``keep = "windows"``) and the true holes' centroids (mm)."""
+    its local maps only at ``keep = "windows"``) and the true holes' centroids (mm; a changing
+    arena's at t = 0)."""
     found = exploration_json(exploration)
     if keep != "windows":
         del found["windows"]
-    true = [shapely.Polygon(ring).centroid for region in arena.regions for ring in region.interiors]
-    return {**found, "true_holes": [[p.x, p.y] for p in true]}
+    static = arena.at(0.0) if isinstance(arena, ChangingArena) else arena
+    return {**found, "true_holes": static.hole_centroids().tolist()}
 
 
 def failed_row(job: Job, status: str, message: str, seconds: float | None = None) -> dict[str, Any]:
@@ -364,6 +363,15 @@ FLUSH_ROWS = 500
 """Rows per write at most (a batch is one transaction)."""
 TOUCH_SECONDS = 30.0
 """How often a run notes in the store that it is alive (``swarmtopo status``)."""
+
+
+def run_cases(todo: list[Job], store, *, scheduler=None, workers=None, progress=None, keep: str = "map"):
+    """Run (or resume) a benchmark's jobs ``todo``: (the :func:`run_sweep` summary, their rows
+    sorted by key)."""
+    from .store import iter_jobs
+
+    summary = run_sweep(todo, store, scheduler=scheduler, workers=workers, progress=progress, keep=keep)
+    return summary, sorted(iter_jobs(store, keys=[job.key for job in todo]), key=lambda row: row["key"])
 
 
 def run_sweep(

@@ -28,9 +28,9 @@ from typing import Any
 import numpy as np
 
 from ..arena import HOLE_SHAPES, OUTER_SHAPES
-from .accuracy import PIPELINES, Rate
+from .accuracy import PIPELINES, Rate, failures_text, percent_text
 from .grid import Job, canonical_json, suite_case_seed
-from .sweep import first_placeable
+from .sweep import first_placeable, run_cases
 
 SUITE = "swarmtopo-timeline/1"
 KINDS = ("appear", "disappear", "door", "none")
@@ -192,13 +192,9 @@ def run_benchmark(store, *, quick: bool = False, split: str = "reporting", per_c
                   scheduler: str | None = None, workers: int | None = None, progress=None, cells=CELLS,
                   keep: str = "map") -> dict[str, Any]:
     """Run (or resume) the cases of ``split``; the summary document (records and :func:`table`)."""
-    from .store import iter_jobs
-    from .sweep import run_sweep
-
     per_cell = per_cell or (QUICK_PER_CELL if quick else REPORTING_PER_CELL)
-    todo = jobs(split, per_cell, cells)
-    summary = run_sweep(todo, store, scheduler=scheduler, workers=workers, progress=progress, keep=keep)
-    rows = sorted(iter_jobs(store, keys=[job.key for job in todo]), key=lambda row: row["key"])
+    summary, rows = run_cases(jobs(split, per_cell, cells), store, scheduler=scheduler, workers=workers,
+                              progress=progress, keep=keep)
     recs = records(rows)
     return {"suite": SUITE, "split": split, "cases_per_cell": per_cell, "within_seconds": WITHIN,
             "seconds": summary.seconds, "jobs_run": summary.run, "workers": summary.workers,
@@ -207,8 +203,7 @@ def run_benchmark(store, *, quick: bool = False, split: str = "reporting", per_c
 
 def markdown(summary: dict[str, Any], command: str) -> str:
     """The benchmark's report as Markdown."""
-    def pct(rate):
-        return "–" if rate["rate"] is None else f"{100 * rate['rate']:.0f} % ({rate['right']}/{rate['total']})"
+    pct = percent_text
 
     def sec(x):
         return "–" if x is None else f"{x:.1f} s"
@@ -225,8 +220,4 @@ def markdown(summary: dict[str, Any], command: str) -> str:
         lines.append(f"| {name} | {t['logs']} | {pct(t['found'])} | {pct(t['found_within'])} | "
                      f"{sec(t['error_median'])} | {sec(t['error_p90'])} | {pct(t['interval_coverage'])} | "
                      f"{t['false_changes_on_changing']} | {pct(t['false_alarms'])} |")
-    failed = [r for r in summary["records"] if r["status"] != "ok"]
-    if failed:
-        lines += ["", f"{len(failed)} map(s) failed and count as nothing found:"]
-        lines += [f"- {r['cell']} case {r['index']}: {r['status']}: {r['error']}" for r in failed]
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines + failures_text(summary["records"], "nothing found")) + "\n"

@@ -15,6 +15,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .._json import read_json
+from .._validate import non_negative, positive
 from ..arena import MM_PER_UNIT
 from ..beacon import BeaconTrack, track_along
 from ..errors import InputError
@@ -31,8 +32,11 @@ def read_beacon_path(path) -> BeaconTrack:
 
 def _track_from_geojson(obj, source: str) -> BeaconTrack:
     if isinstance(obj, dict) and obj.get("type") == "FeatureCollection":
-        lines = [f for f in obj.get("features") or [] if isinstance(f, dict)
-                 and (f.get("geometry") or {}).get("type") == "LineString"]
+        features = obj.get("features")
+        if not isinstance(features, list):
+            raise InputError("a FeatureCollection's 'features' must be a list", file=source)
+        lines = [f for f in features if isinstance(f, dict) and isinstance(f.get("geometry"), dict)
+                 and f["geometry"].get("type") == "LineString"]
         if len(lines) != 1:
             raise InputError(f"a beacon path FeatureCollection needs exactly one LineString feature, found "
                              f"{len(lines)}", file=source)
@@ -46,7 +50,7 @@ def _track_from_geojson(obj, source: str) -> BeaconTrack:
     if not isinstance(props, dict) or "speed" not in props:
         raise InputError("the beacon path's properties need a 'speed' (mm/s)", file=source)
     unit = props.get("units", "mm")
-    if unit not in MM_PER_UNIT:
+    if not isinstance(unit, str) or unit not in MM_PER_UNIT:
         raise InputError(f"properties.units must be one of {', '.join(MM_PER_UNIT)}", file=source, value=unit)
     scale = MM_PER_UNIT[unit]
     coords = obj.get("coordinates")
@@ -55,13 +59,9 @@ def _track_from_geojson(obj, source: str) -> BeaconTrack:
     except (TypeError, ValueError):
         raise InputError("the LineString's coordinates must be [x, y] numbers", file=source) from None
     values = {}
-    for key, default in (("speed", None), ("start", 0.0), ("dwell", 0.0)):
-        value = props.get(key, default)
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise InputError(f"properties.{key} must be a number", file=source, value=value)
-        values[key] = float(value)
-    try:
-        return track_along(points, values["speed"] * scale, start=values["start"], dwell=values["dwell"],
-                           source=source)
-    except InputError as exc:
-        raise InputError(exc.reason, file=source, column=exc.column, value=exc.value) from None
+    for key, default, check in (("speed", None, positive), ("start", 0.0, non_negative), ("dwell", 0.0, non_negative)):
+        try:
+            values[key] = check(f"properties.{key}", props.get(key, default))
+        except InputError as exc:
+            raise InputError(exc.reason, file=source, value=exc.value) from None
+    return track_along(points, values["speed"] * scale, start=values["start"], dwell=values["dwell"], source=source)

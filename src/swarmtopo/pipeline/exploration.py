@@ -8,7 +8,8 @@ around the leader.  Its log is mapped as usual, and besides:
    is mapped and read on its own (holes counted, beta_1^w).  Their length is the time
    the leader takes to travel ``EXPLORATION_TRAVEL`` R at its mean moving speed v_L
    (at least the map's own window length W, the time the swarm needs to map anything;
-   with the whole log as one window, ``--paper``, the travel alone),
+   with the whole log as one window, ``--paper``, the travel alone; without a moving
+   leader, W),
    their step half that, at most ``MAX_EXPLORATION_WINDOWS`` of them.
 2. **Holes in view.**  The windows' counts, in time order, are cut into segments of
    constant count by the timeline's penalised fit (:func:`.timeline.segment`, with
@@ -33,15 +34,18 @@ around the leader.  Its log is mapped as usual, and besides:
    view from): that point is its estimate.  Its uncertainty radius is
    ``LATERAL_FRACTION`` R (it may lie to either side of the path) plus the leader's
    travel in one window step (the resolution of the dates).  A hole still in view at
-   the last window (``open``: the leader stopped near it) is placed halfway along the
-   stretch of path it was in view from, within R plus one step.
+   the last window (the leader stopped near it) is placed halfway along the stretch of
+   path it was in view from, within R plus one step.  Holes in view at the first or the
+   last window are ``open``: the time they came into view, or left it, is unknown.
 4. **One count per hole.**  A leader that comes back sees a hole again: two holes whose
    times in view do not overlap and whose estimates are closer than
    ``REVISIT_FRACTION`` R are one hole (its estimate the windows-weighted mean, its
    radius the larger).  Holes in view at the same time are different holes.
 
 The global beta_1 is the number of holes; beta_0 is the map's.  Its confidence is not
-calibrated (None).  Warnings: a leader faster than ``FAST_LEADER`` v_c (when the log
+calibrated (None).  With fewer than ``MIN_LOCAL_MAPS`` local maps there is no global
+count, and the map keeps its pooled beta_1.  The track is first cut to the mapped
+events' span (a leader's fix outside it says nothing about them).  Warnings: a leader faster than ``FAST_LEADER`` v_c (when the log
 gives v_c); a stretch of the leader's path longer than R without a local map (too few
 encounters there); too few local maps to tell a hole from noise.
 """
@@ -51,6 +55,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import shapely
 
 from ..beacon import BeaconTrack
 from ..log import EncounterLog
@@ -91,32 +96,46 @@ def leader_speed(track: BeaconTrack) -> float:
     return float(steps.sum()) / moving if moving > 0 else 0.0
 
 
-def exploration_length(log: EncounterLog, window_length: float) -> float:
-    """Length (s) of a local map's window (module docstring, 1)."""
-    speed = leader_speed(log.beacon)
-    if speed == 0:
-        return window_length
-    travel = EXPLORATION_TRAVEL * leash_of(log) / speed
-    return max(window_length, travel) if math.isfinite(window_length) else travel  # the paper's: one window per local map
+def exploration_windows(log: EncounterLog, window_length: float, span: tuple[float, float]) -> tuple[float, float]:
+    """(length, step) s of the local maps over the events' ``span`` (module docstring, 1):
+    half a length apart, or further apart if that would make more than
+    ``MAX_EXPLORATION_WINDOWS``; an infinite length when the leader does not move and the
+    map is one window."""
+    track = log.beacon.between(*span)
+    speed = leader_speed(track)
+    length = window_length
+    if speed > 0:
+        travel = EXPLORATION_TRAVEL * leash_of(log) / speed
+        length = max(window_length, travel) if math.isfinite(window_length) else travel  # --paper: the travel
+    if not math.isfinite(length):
+        return length, length
+    return length, max(length / 2, (span[1] - span[0] - length) / (MAX_EXPLORATION_WINDOWS - 1))
 
 
 def stitch(windows: list[TimelineWindow], track: BeaconTrack, leash: float, length: float, step: float,
-           beta0: int, meta: dict, penalty: float = EXPLORATION_PENALTY, handover: float = HANDOVER_TRAVEL
-           ) -> Exploration:
-    """The global map of the local maps ``windows`` (read, in order of their middles; module docstring)."""
+           beta0: int, meta: dict, span: tuple[float, float], penalty: float = EXPLORATION_PENALTY,
+           handover: float = HANDOVER_TRAVEL) -> Exploration:
+    """The global map of the local maps ``windows`` (read, in order of their middles; module
+    docstring) of the events in ``span`` = (first, last) time; the track is cut to it.  With
+    fewer than ``MIN_LOCAL_MAPS`` local maps its beta_1 is None (no global count)."""
+    warnings = _track_warnings(track, span)
+    track = track.between(*span)
     speed = leader_speed(track)
     read = [w for w in windows if 1 in w.betti]
     mids = np.array([(w.t0 + w.t1) / 2 for w in read])
     lx, ly = track.position(mids)
     resolution = speed * step
     holes: list[ExploredHole] = []
-    if read:
+    if len(read) >= MIN_LOCAL_MAPS:
+        arc, first = _arclength(track)
         cuts = segment([w.betti[1] for w in read], penalty)
         bounds = [read[0].t0] + [(read[j - 1].t0 + read[j].t1) / 2 for _, j, _ in cuts[:-1]] + [read[-1].t1]
         phases = []  # (start, count, windows, handover: every hole in view is a new one)
         for (i, j, value), t0, t1 in zip(cuts, bounds[:-1], bounds[1:]):
-            parts = max(1, round(track.distance_travelled(t0, t1) / (handover * leash))) if value else 1
-            phases += [(t0 + (t1 - t0) * k / parts, value, (j - i) / parts, k > 0) for k in range(parts)]
+            s0, s1 = np.interp([t0, t1], track.t, arc)
+            parts = min(max(1, round((s1 - s0) / (handover * leash))), j - i) if value else 1
+            cut_times = np.interp(s0 + (s1 - s0) * np.arange(1, parts) / parts, arc[first], track.t[first])
+            phases += [(t, value, (j - i) / parts, k > 0) for k, t in enumerate([t0, *cut_times])]
         in_view: list[list] = []  # [t_in, windows] of each hole in view, oldest first
         for t_start, value, count, fresh in phases:
             leaving = len(in_view) if fresh else max(len(in_view) - value, 0)  # the holes longest in view leave
@@ -129,9 +148,11 @@ def stitch(windows: list[TimelineWindow], track: BeaconTrack, leash: float, leng
         holes = _merge_revisits(holes, REVISIT_FRACTION * leash)
     path = np.column_stack([track.x, track.y])
     return Exploration(leash=leash, leader_speed=speed, length=length, step=step,
-                       betti={0: beta0, 1: len(holes)}, holes=sorted(holes, key=lambda h: h.t_in), windows=read,
+                       betti={0: beta0, 1: len(holes) if len(read) >= MIN_LOCAL_MAPS else None},
+                       holes=sorted(holes, key=lambda h: h.t_in), windows=read,
                        leader_xy=np.column_stack([lx, ly]) if read else np.empty((0, 2)), path=path,
-                       coverage=_coverage(path, leash), warnings=_warnings(read, track, leash, speed, meta))
+                       coverage=float(reach(path, leash).area),
+                       warnings=warnings + _warnings(read, track, leash, speed, meta))
 
 
 def _hole(track: BeaconTrack, leash: float, t_in: float, t_out: float, windows: int, resolution: float,
@@ -146,7 +167,7 @@ def _hole(track: BeaconTrack, leash: float, t_in: float, t_out: float, windows: 
     s_hole = (s_in + s_out) / 2 if at_end else min(max(s_out - leash, s_in), s_out)
     x = float(np.interp(s_hole, arc[keep], track.x[keep]))
     y = float(np.interp(s_hole, arc[keep], track.y[keep]))
-    radius = (leash if open_ else LATERAL_FRACTION * leash) + resolution
+    radius = (leash if at_end else LATERAL_FRACTION * leash) + resolution
     return ExploredHole(x, y, radius, float(t_in), float(t_out), int(round(windows)), bool(open_))
 
 
@@ -176,7 +197,7 @@ def _merge_revisits(holes: list[ExploredHole], distance: float) -> list[Explored
         if len(group) == 1:
             out.append(group[0])
             continue
-        w = np.array([h.windows for h in group], dtype=float)
+        w = np.array([max(h.windows, 1) for h in group], dtype=float)
         out.append(ExploredHole(float(np.average([h.x for h in group], weights=w)),
                                 float(np.average([h.y for h in group], weights=w)),
                                 max(h.radius for h in group), min(h.t_in for h in group),
@@ -191,12 +212,21 @@ def _revisit(a: list[ExploredHole], b: list[ExploredHole], distance: float) -> b
     return apart and close
 
 
-def _coverage(path: np.ndarray, leash: float) -> float:
-    """Area (mm^2) within R of the leader's path: what the swarm can have seen."""
-    import shapely
+def reach(points: np.ndarray, leash: float):
+    """The area (a shapely geometry, mm) within R of the leader's positions ``points`` (P, 2),
+    taken as a path: what the swarm can have seen."""
+    line = shapely.Point(points[0]) if len(np.unique(points, axis=0)) == 1 else shapely.LineString(points)
+    return line.buffer(leash)
 
-    geometry = shapely.Point(path[0]) if len(np.unique(path, axis=0)) == 1 else shapely.LineString(path)
-    return float(geometry.buffer(leash).area)
+
+def _track_warnings(track: BeaconTrack, span: tuple[float, float]) -> list[str]:
+    """The leader's track does not cover the mapped events."""
+    start, end = span
+    if track.t[0] <= start and track.t[-1] >= end:
+        return []
+    return [f"the leader's track (beacon.csv) runs from {track.t[0]:g} to {track.t[-1]:g} s but the encounters mapped "
+            f"run from {start:g} to {end:g} s: outside its rows the leader is taken to stand at its first or last "
+            "position"]
 
 
 def _warnings(read: list[TimelineWindow], track: BeaconTrack, leash: float, speed: float, meta: dict) -> list[str]:
@@ -208,12 +238,13 @@ def _warnings(read: list[TimelineWindow], track: BeaconTrack, leash: float, spee
                    f"{v_c:g} mm/s: the swarm trails behind it and holes it passes can go unseen (docs/exploration.md)")
     if len(read) < MIN_LOCAL_MAPS:
         out.append(f"only {len(read)} local maps along the leader's path (at least {MIN_LOCAL_MAPS:.0f} are needed "
-                   "to tell a hole from a misread window): the hole count is not to be trusted")
+                   "to tell a hole from a misread window): no global count; beta_1 is the pooled map's")
     ends = [track.t[0]] + [t for w in read for t in (w.t0, w.t1)] + [track.t[-1]]
     for gap_start, gap_end in zip(ends[::2], ends[1::2]):  # from each window's end to the next one's start
-        if gap_end > gap_start and track.distance_travelled(gap_start, gap_end) > leash:
+        travelled = track.distance_travelled(gap_start, gap_end) if gap_end > gap_start else 0.0
+        if travelled > leash:
             out.append(f"no local map from {gap_start:.0f} to {gap_end:.0f} s, while the leader travelled "
-                       f"{track.distance_travelled(gap_start, gap_end):.0f} mm (more than the leash R = {leash:g} mm):"
-                       " too few encounters there; holes it passed are not counted")
+                       f"{travelled:.0f} mm (more than the leash R = {leash:g} mm): too few encounters there; holes "
+                       "it passed are not counted")
     return out
 

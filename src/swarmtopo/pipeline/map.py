@@ -21,6 +21,7 @@ reader only.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import replace
 from typing import Any, Callable
@@ -38,7 +39,7 @@ from ..topology.embed import mds
 from ..topology.persistence import Diagram, rips_persistence
 from .config import MapConfig
 from .engine import engine_for
-from .exploration import MAX_EXPLORATION_WINDOWS, exploration_length, leash_of, stitch
+from .exploration import MAX_EXPLORATION_WINDOWS, exploration_windows, leash_of, stitch
 from .regions import MIN_REGION_AGENTS, split_regions
 from .result import RegionMap, RegionScales, TimelineWindow, TopologicalMap, WindowMap, software_versions
 from .settings import Settings, resolve
@@ -96,10 +97,13 @@ def map_encounters(
     reader = reader or load_classifier(shipped_reader_for(log))
     settings = resolve(log, config, reader)
     leash = leash_of(log)
-    exploring = leash is not None and config.timeline_length is None and config.timeline_step is None
-    # a beacon-led log's local maps are the timeline's windows, of a length set by the leader's speed
-    timeline_config = (replace(config, timeline_length=exploration_length(log, settings.window_length[0]))
-                       if exploring else config)
+    span = (float(settings.times[0]), float(settings.times[-1]))
+    timeline_config = config
+    if leash is not None and config.timeline_length is None and config.timeline_step is None:
+        # a beacon-led log's local maps are the timeline's windows, of a length set by the leader's speed
+        length, step = exploration_windows(log, settings.window_length[0], span)
+        if math.isfinite(length):
+            timeline_config = replace(config, timeline_length=length, timeline_step=step)
     # a timeline of its own windows, decided now: a step too small for the log is refused before any map work
     timeline_spans = own_spans(timeline_config, settings.window_length[0], settings.times,
                                **({"cap": MAX_EXPLORATION_WINDOWS} if leash is not None else {}))
@@ -147,10 +151,17 @@ def map_encounters(
     length, step = timeline_settings(timeline_config, settings.window_length[0])
     timeline = build_timeline(timeline_windows, length, step, betti, confidence, log,
                               note=None if timeline_windows else no_timeline_note(timeline_config, length))
+    warnings = silence_warnings(settings.times, settings.window_length[0]) + _extrapolation_warnings(betti)
     exploration = None
-    if leash is not None and betti.get(1) is not None:  # the global map's counts are the answer
-        exploration = stitch(timeline.windows, log.beacon, leash, length, step, len(regions), log.meta)
-        betti[1], confidence[1] = exploration.betti[1], None
+    if leash is not None and betti.get(1) is not None:
+        exploration = stitch(timeline.windows, log.beacon, leash, length, step, len(regions), log.meta, span)
+        if exploration.betti[1] is not None:  # the global map's count is the answer
+            betti[1], confidence[1] = exploration.betti[1], None
+            warnings = silence_warnings(settings.times, settings.window_length[0])
+    elif (log.beacon is None) != ("leash" not in log.meta):
+        warnings.append("the log has " + ("a leader's track (beacon.csv) but no 'leash' in meta.json"
+                                          if log.beacon is not None else "a 'leash' in meta.json but no beacon.csv")
+                        + ": mapped as a log without a leader (docs/exploration.md)")
     return TopologicalMap(
         betti=betti,
         confidence=confidence,
@@ -167,8 +178,7 @@ def map_encounters(
         diffusion_time=settings.diffusion_time,
         window_length=settings.window_length,
         windows_left_out=settings.windows_left_out,
-        log_warnings=(silence_warnings(settings.times, settings.window_length[0]) + _extrapolation_warnings(betti)
-                      + (exploration.warnings if exploration else _change_warnings(timeline))),
+        log_warnings=warnings + (exploration.warnings if exploration else _change_warnings(timeline)),
         beta0_evidence=split.beta0,
         contact_trace=len(log.status_t) == 0,
         software=software_versions(),

@@ -195,7 +195,7 @@ class Exploration:
     leader_speed: float  # mm/s, mean while moving
     length: float  # s, each local map's window
     step: float
-    betti: dict[int, int]
+    betti: dict[int, int | None]  # beta_1 None: too few local maps for a global count
     holes: list[ExploredHole]
     windows: list[TimelineWindow]
     leader_xy: np.ndarray  # (K, 2) the leader at the middle of each window
@@ -205,6 +205,8 @@ class Exploration:
 
     def summary(self) -> str:
         """One line: the global counts and where the holes are."""
+        if self.betti[1] is None:
+            return f"no global map: {len(self.windows)} local maps along the leader's path are too few"
         where = "; ".join(f"({h.x:.0f}, {h.y:.0f}) mm +- {h.radius:.0f}" for h in self.holes)
         return (f"global map along the leader's path: beta_0 = {self.betti[0]}, beta_1 = {self.betti[1]}"
                 + (f"; holes at {where}" if where else "") + f" ({len(self.windows)} local maps)")

@@ -63,7 +63,8 @@ def steer(agents, stimulated, bx, by, leash, m, walls, rng):
 def stimulate(ag, ux, uy, m, walls, rng):
     """One stimulated agent; (ux, uy) is the unit bearing to the beacon."""
     moving = ag['state']
-    if moving == S:
+    stopped = moving == S
+    if stopped:
         ag['stop_left'] = 1  # decide() resumes the moving state at this step
         moving = ag['resume_state']
     x, y = ag['x'], ag['y']
@@ -76,6 +77,8 @@ def stimulate(ag, ux, uy, m, walls, rng):
         way = ag['wf_dir']
         start_wall_following(ag, m, nearest_wall(walls, x, y)[0], rng)
         ag['wf_dir'] = way  # round the same way as its last wall: no dithering at a corner
+        if stopped:  # decide() resumes it, following the wall, with a fresh moving time
+            ag['state'], ag['resume_state'] = S, WF
         return
     ag['heading'] = math.atan2(uy, ux) + rng.normal(0.0, HEADING_ERROR)
     ag['seg_left'] = max(ag['seg_left'], m.v_c * m.dt)

@@ -179,7 +179,11 @@ def simulate(
     model = _motion.make_model(motion, r_d, dt)
     start_area = None
     if beacon is not None:
-        start_area = shapely.Point(*(float(c[0]) for c in beacon.position([0.0]))).buffer(leash, quad_segs=32)
+        bx, by = (float(c[0]) for c in beacon.position([0.0]))
+        start_area = shapely.Point(bx, by).buffer(leash, quad_segs=32)
+        if start_area.intersection(free.geometry).area <= 0:
+            raise InputError(f"the leader's first position ({bx:g}, {by:g}) mm is not within the leash R = {leash:g} mm "
+                             "of the arena's free space: the agents start within R of it")
     agents = _motion.new_swarm(free.sample_uniform(n, gen, clearance=_walls.WALL_EPS, within=start_area), model, gen)
     stimulated, stimulus = 0, np.zeros(n, np.bool_)
     tracker = _sensing.EncounterTracker(n, r_d, walls if sensing.walls_block else None,
@@ -242,7 +246,7 @@ def simulate(
                                        "stimulated_share": stimulated / (n * (n_steps + 1))}
     log, order = _build_log(events, status, static_agents, static_times, meta)
     if beacon is not None:
-        log = dataclasses.replace(log, beacon=beacon.clipped(meta["duration"]))
+        log = dataclasses.replace(log, beacon=beacon.between(0.0, meta["duration"]))
     return Simulation(
         log=log,
         truth=_truth(events, order) if truth else None,

@@ -30,6 +30,7 @@ import numpy as np
 from ..changing import timeline_text
 from ..topology.cycles import encircled_obstacles, event_positions
 from ..log import STATES, EncounterLog
+from ..pipeline.exploration import reach
 from ..pipeline.result import TopologicalMap
 from .summary import map_json
 from .plots import position_colors
@@ -221,7 +222,9 @@ def _exploration_section(doc: dict, figures: dict, arena) -> str:
             f'<p class="note">A leader moved at {found["leader_speed"]:.3g} mm/s with the swarm on a leash of '
             f'R = {found["leash"]:g} mm; {len(found["windows"])} local maps of {found["length"]:.3g} s each (every '
             f'{found["step"]:.3g} s) counted the holes in the swarm\'s view. A hole is counted once, from when it came '
-            "into view to when it left, and placed on the leader's path halfway between (docs/exploration.md). "
+            "into view to when it left, and placed on the leader's path R behind where the leader was when it left "
+            "the swarm's view (the leash is the swarm's trailing edge; a hole still in view at the end: halfway "
+            "along its time in view; docs/exploration.md in the source repository). "
             f'Shaded: within R of the leader at its local maps (within R of its whole path: '
             f'{found["coverage_mm2"] / 1e6:.2f} m&sup2;), what the swarm can have seen'
             f'{"; grey: the true arena" if arena is not None else ""}.</p>{table}'
@@ -229,13 +232,10 @@ def _exploration_section(doc: dict, figures: dict, arena) -> str:
 
 
 def _exploration_figure(found: dict, arena) -> dict:
-    import shapely
-
     data = _arena_traces(arena) if arena is not None else []
     path = np.asarray([w["leader"] for w in found["windows"]], dtype=float).reshape(-1, 2)
     if len(path):
-        line = shapely.LineString(path) if len(np.unique(path, axis=0)) > 1 else shapely.Point(path[0])
-        for poly in getattr(area := line.buffer(found["leash"]), "geoms", [area]):
+        for poly in getattr(area := reach(path, found["leash"]), "geoms", [area]):
             x, y = poly.exterior.xy
             data.append({"type": "scatter", "x": _floats(x, 1), "y": _floats(y, 1), "fill": "toself", "mode": "lines",
                          "fillcolor": "rgba(31,119,180,0.12)", "line": {"color": "rgba(31,119,180,0.4)", "width": 1},

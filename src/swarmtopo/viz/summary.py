@@ -106,9 +106,11 @@ def timeline_json(timeline: Timeline) -> dict[str, Any]:
 
 def exploration_json(exploration: Exploration) -> dict[str, Any]:
     """map.json's ``exploration``: the global map of a beacon-led log."""
+    def number(x):
+        return float(x) if math.isfinite(x) else None
     return {
         "summary": exploration.summary(), "leash": exploration.leash, "leader_speed": exploration.leader_speed,
-        "length": exploration.length, "step": exploration.step, "coverage_mm2": exploration.coverage,
+        "length": number(exploration.length), "step": number(exploration.step), "coverage_mm2": exploration.coverage,
         "betti": {str(n): b for n, b in sorted(exploration.betti.items())},
         "holes": [{"x": h.x, "y": h.y, "radius": h.radius, "in_view": [h.t_in, h.t_out], "windows": h.windows,
                    "open": h.open} for h in exploration.holes],
