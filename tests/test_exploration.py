@@ -224,6 +224,10 @@ def test_warnings_name_a_fast_leader_and_a_stretch_without_local_maps():
     late = stitch(_windows([0] * 10), BeaconTrack.from_columns([200.0, 300.0], [0.0, 100.0], [0.0, 0.0]), 100.0,
                   20.0, 10.0, 1, {}, (0.0, 110.0))
     assert late.leader_speed == 0.0 and late.warnings[0].startswith("the leader's track (beacon.csv) runs from 200")
+    short = stitch(_windows([0] * 10), _straight(), 100.0, 20.0, 10.0, 1, {"r_d": 30.0}, SPAN)
+    assert any(w.startswith("the leash R = 100 mm is less than 5 x r_d = 150 mm") for w in short.warnings)
+    assert not any(w.startswith("the leash") for w in stitch(_windows([0] * 10), _straight(), 150.0, 20.0, 10.0, 1,
+                                                             {"r_d": 30.0}, SPAN).warnings)
     few = stitch(_windows([1] * 5), _straight(), 100.0, 20.0, 10.0, 1, {}, SPAN)
     assert few.betti[1] is None and few.holes == [] and "no global count" in few.warnings[0]
 

@@ -43,7 +43,8 @@ around the leader.  Its log is mapped as usual, and besides:
    radius the larger).  Holes in view at the same time are different holes.
 
 The global beta_1 is the number of holes; beta_0 is the map's.  Its confidence is not
-calibrated (None).  With fewer than ``MIN_LOCAL_MAPS`` local maps there is no global
+calibrated (None).  Warnings: a leash shorter than ``SHORT_LEASH`` r_d.  With fewer
+than ``MIN_LOCAL_MAPS`` local maps there is no global
 count, and the map keeps its pooled beta_1.  The track is first cut to the mapped
 events' span (a leader's fix outside it says nothing about them).  Warnings: a leader faster than ``FAST_LEADER`` v_c (when the log
 gives v_c); a stretch of the leader's path longer than R without a local map (too few
@@ -79,6 +80,9 @@ FAST_LEADER = 0.25
 """A leader faster than this share of the agents' speed v_c leaves the swarm behind (docs/exploration.md)."""
 EXPLORATION_PENALTY = 2.0
 """Windows a change of the count costs in the segmentation of the local counts (:func:`.timeline.segment`)."""
+SHORT_LEASH = 5.0
+"""A leash shorter than this many detection radii r_d keeps a swarm too small to enclose
+most holes (docs/exploration.md, "Limits"): warned of."""
 MIN_LOCAL_MAPS = 2 * EXPLORATION_PENALTY + 2
 """Fewest local maps for a hole count: a segment between two changes needs more than 2 x the penalty."""
 
@@ -236,6 +240,10 @@ def _warnings(read: list[TimelineWindow], track: BeaconTrack, leash: float, spee
     if isinstance(v_c, (int, float)) and v_c > 0 and speed > FAST_LEADER * v_c:
         out.append(f"the leader moved at {speed:.3g} mm/s, faster than {FAST_LEADER:g} x the agents' speed v_c = "
                    f"{v_c:g} mm/s: the swarm trails behind it and holes it passes can go unseen (docs/exploration.md)")
+    r_d = meta.get("r_d")
+    if isinstance(r_d, (int, float)) and 0 < r_d and leash < SHORT_LEASH * r_d:
+        out.append(f"the leash R = {leash:g} mm is less than {SHORT_LEASH:g} x r_d = {SHORT_LEASH * r_d:g} mm: the swarm "
+                   f"round the leader is too small to enclose a hole about R or more across, and such holes go unseen")
     if len(read) < MIN_LOCAL_MAPS:
         out.append(f"only {len(read)} local maps along the leader's path (at least {MIN_LOCAL_MAPS:.0f} are needed "
                    "to tell a hole from a misread window): no global count; beta_1 is the pooled map's")
