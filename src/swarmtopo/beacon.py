@@ -69,12 +69,14 @@ class BeaconTrack:
         x, y = self.position(t)
         return BeaconTrack(t, x, y)
 
+    def arclength(self) -> np.ndarray:
+        """Path length (mm) the leader has travelled at each row (non-decreasing, 0 at the first)."""
+        return np.r_[0.0, np.cumsum(np.hypot(np.diff(self.x), np.diff(self.y)))]
+
     def distance_travelled(self, t0: float, t1: float) -> float:
-        """Path length (mm) of the leader between times ``t0`` and ``t1``."""
-        inside = (self.t > t0) & (self.t < t1)
-        ts = np.r_[t0, self.t[inside], t1]
-        x, y = self.position(ts)
-        return float(np.hypot(np.diff(x), np.diff(y)).sum())
+        """Path length (mm) of the leader between times ``t0`` <= ``t1``."""
+        s0, s1 = np.interp([t0, t1], self.t, self.arclength())
+        return float(s1 - s0)
 
     def __len__(self) -> int:
         return len(self.t)

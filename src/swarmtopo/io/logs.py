@@ -53,9 +53,8 @@ from __future__ import annotations
 import json
 import math
 import shutil
-from pathlib import Path
-
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pyarrow as pa

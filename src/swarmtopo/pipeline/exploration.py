@@ -53,6 +53,7 @@ encounters there); too few local maps to tell a hole from noise.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -95,7 +96,7 @@ def leash_of(log: EncounterLog) -> float | None:
 
 def leader_speed(track: BeaconTrack) -> float:
     """The leader's mean speed while moving, mm/s (0 if it never moves)."""
-    steps = np.hypot(np.diff(track.x), np.diff(track.y))
+    steps = np.diff(track.arclength())
     moving = float(np.diff(track.t)[steps > 0].sum())
     return float(steps.sum()) / moving if moving > 0 else 0.0
 
@@ -126,12 +127,12 @@ def stitch(windows: list[TimelineWindow], track: BeaconTrack, leash: float, leng
     track = track.between(*span)
     speed = leader_speed(track)
     read = [w for w in windows if 1 in w.betti]
-    mids = np.array([(w.t0 + w.t1) / 2 for w in read])
-    lx, ly = track.position(mids)
+    enough = len(read) >= MIN_LOCAL_MAPS
     resolution = speed * step
     holes: list[ExploredHole] = []
-    if len(read) >= MIN_LOCAL_MAPS:
-        arc, first = _arclength(track)
+    if enough:
+        arc = track.arclength()
+        first = np.unique(arc, return_index=True)[1]  # the rows where the path grows: arclength -> time
         cuts = segment([w.betti[1] for w in read], penalty)
         bounds = [read[0].t0] + [(read[j - 1].t0 + read[j].t1) / 2 for _, j, _ in cuts[:-1]] + [read[-1].t1]
         phases = []  # (start, count, windows, handover: every hole in view is a new one)
@@ -143,59 +144,45 @@ def stitch(windows: list[TimelineWindow], track: BeaconTrack, leash: float, leng
         in_view: list[list] = []  # [t_in, windows] of each hole in view, oldest first
         for t_start, value, count, fresh in phases:
             leaving = len(in_view) if fresh else max(len(in_view) - value, 0)  # the holes longest in view leave
-            holes += [_hole(track, leash, t_in, t_start, seen, resolution, open_=t_in == read[0].t0)
+            holes += [_hole(track, arc, first, leash, t_in, t_start, seen, resolution, open_=t_in == read[0].t0)
                       for t_in, seen in in_view[:leaving]]
             in_view = in_view[leaving:] + [[t_start, 0.0] for _ in range(value - len(in_view) + leaving)]
             for hole in in_view:
                 hole[1] += count
-        holes += [_hole(track, leash, t_in, read[-1].t1, count, resolution, open_=True) for t_in, count in in_view]
+        holes += [_hole(track, arc, first, leash, t_in, read[-1].t1, count, resolution, open_=True)
+                  for t_in, count in in_view]
         holes = _merge_revisits(holes, REVISIT_FRACTION * leash)
-    path = np.column_stack([track.x, track.y])
+    leader_x, leader_y = track.position([(w.t0 + w.t1) / 2 for w in read])
     return Exploration(leash=leash, leader_speed=speed, length=length, step=step,
-                       betti={0: beta0, 1: len(holes) if len(read) >= MIN_LOCAL_MAPS else None},
+                       betti={0: beta0, 1: len(holes) if enough else None},
                        holes=sorted(holes, key=lambda h: h.t_in), windows=read,
-                       leader_xy=np.column_stack([lx, ly]) if read else np.empty((0, 2)), path=path,
-                       coverage=float(reach(path, leash).area),
+                       leader_xy=np.column_stack([leader_x, leader_y]),
+                       coverage=float(reach(np.column_stack([track.x, track.y]), leash).area),
                        warnings=warnings + _warnings(read, track, leash, speed, meta))
 
 
-def _hole(track: BeaconTrack, leash: float, t_in: float, t_out: float, windows: int, resolution: float,
-          open_: bool) -> ExploredHole:
+def _hole(track: BeaconTrack, arc: np.ndarray, first: np.ndarray, leash: float, t_in: float, t_out: float,
+          windows: float, resolution: float, open_: bool) -> ExploredHole:
     """A hole in view from ``t_in`` to ``t_out`` (module docstring, 3): on the leader's path
     R behind where the leader was when the hole left the swarm's view (its trailing edge, the
     leash), within the part of the path it was in view from; a hole still in view at the end,
-    halfway along that part."""
-    arc, keep = _arclength(track)
+    halfway along that part.  ``arc``: the track's arclength at each row, ``first``: the rows
+    where it grows."""
     s_in, s_out = np.interp([t_in, t_out], track.t, arc)
     at_end = t_out >= track.t[-1] or s_out >= arc[-1]
     s_hole = (s_in + s_out) / 2 if at_end else min(max(s_out - leash, s_in), s_out)
-    x = float(np.interp(s_hole, arc[keep], track.x[keep]))
-    y = float(np.interp(s_hole, arc[keep], track.y[keep]))
+    x = float(np.interp(s_hole, arc[first], track.x[first]))
+    y = float(np.interp(s_hole, arc[first], track.y[first]))
     radius = (leash if at_end else LATERAL_FRACTION * leash) + resolution
     return ExploredHole(x, y, radius, float(t_in), float(t_out), int(round(windows)), bool(open_))
-
-
-def _arclength(track: BeaconTrack) -> tuple[np.ndarray, np.ndarray]:
-    """Path length travelled by each row, and the rows where it grows (for interpolating positions)."""
-    arc = np.r_[0.0, np.cumsum(np.hypot(np.diff(track.x), np.diff(track.y)))]
-    _, first = np.unique(arc, return_index=True)
-    return arc, first
 
 
 def _merge_revisits(holes: list[ExploredHole], distance: float) -> list[ExploredHole]:
     """One hole for each group of holes never in view together and closer than ``distance`` (module docstring, 4)."""
     groups = [[h] for h in holes]
-    merged = True
-    while merged:
-        merged = False
-        for a in range(len(groups)):
-            for b in range(a + 1, len(groups)):
-                if _revisit(groups[a], groups[b], distance):
-                    groups[a] += groups.pop(b)
-                    merged = True
-                    break
-            if merged:
-                break
+    while pair := next(((a, b) for a, b in itertools.combinations(range(len(groups)), 2)
+                        if _revisit(groups[a], groups[b], distance)), None):
+        groups[pair[0]] += groups.pop(pair[1])
     out = []
     for group in groups:
         if len(group) == 1:

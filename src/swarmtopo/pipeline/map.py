@@ -44,7 +44,7 @@ from .regions import MIN_REGION_AGENTS, split_regions
 from .result import RegionMap, RegionScales, TimelineWindow, TopologicalMap, WindowMap, software_versions
 from .settings import Settings, resolve
 from .tasks import AUTO_COVER_FACTOR, cut_window, describe_part, map_band, window_part
-from .timeline import (build_timeline, no_timeline_note, own_spans, read_component, scaled_h1, split_window,
+from .timeline import (MAX_TIMELINE_WINDOWS, build_timeline, no_timeline_note, own_spans, read_component, scaled_h1, split_window,
                        timeline_settings, timeline_window)
 from .windows import events_in, silence_warnings
 CALIBRATED_HOLES = 3
@@ -106,7 +106,7 @@ def map_encounters(
             timeline_config = replace(config, timeline_length=length, timeline_step=step)
     # a timeline of its own windows, decided now: a step too small for the log is refused before any map work
     timeline_spans = own_spans(timeline_config, settings.window_length[0], settings.times,
-                               **({"cap": MAX_EXPLORATION_WINDOWS} if leash is not None else {}))
+                               MAX_TIMELINE_WINDOWS if leash is None else MAX_EXPLORATION_WINDOWS)
     rng = np.random.default_rng(config.seed)
     say = progress or (lambda stage: None)
     timings = dict.fromkeys(STAGES, 0.0)

@@ -199,7 +199,6 @@ class Exploration:
     holes: list[ExploredHole]
     windows: list[TimelineWindow]
     leader_xy: np.ndarray  # (K, 2) the leader at the middle of each window
-    path: np.ndarray  # (P, 2) the leader's track, its rows
     coverage: float
     warnings: list[str]
 
