@@ -151,7 +151,7 @@ def test_a_window_of_a_trace_takes_the_hop_cost_of_its_own_pace():
     a = rng.integers(0, 20, len(t))
     b = (a + rng.integers(1, 20, len(t))) % 20
     log = EncounterLog.from_records(t, a, b)
-    early = map_encounters(log, MapConfig(window=(0.0, 99.9), **FAST))
+    early = map_encounters(log, MapConfig(window=(0.0, 99.9), recontacts="keep", **FAST))
     h, _ = settings.hop_cost(log.window(0.0, 99.9), None)
     assert map_json(early)["params"]["hop_cost_used"] == pytest.approx(h)
     assert h < 0.5 * settings.hop_cost(log, None)[0]

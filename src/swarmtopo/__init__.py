@@ -13,6 +13,7 @@ A swarm of agents that cannot localize themselves reports encounter events
 The public names (loaded on first use, so ``import swarmtopo`` stays light):
 
 ``simulate``         run the bio-inspired swarm in an arena -> ``Simulation`` (``.log``)
+``MotionParams``     the cockroach's motion; ``Billiard``, ``RunAndTumble``, ``Brownian``, ``LevyWalk``, ``Flocking`` others
 ``read_log``         a log folder (events.csv|parquet, status, meta.json) -> ``EncounterLog``
 ``read_trace``       a proximity trace (CSV/Parquet, SocioPatterns, ONE) -> ``(EncounterLog, report)``
 ``map_encounters``   ``EncounterLog`` -> ``TopologicalMap`` (Betti numbers, confidence, diagrams)
@@ -38,6 +39,12 @@ except PackageNotFoundError:  # running from a source tree without install
 _PUBLIC = {
     "simulate": "swarmtopo.sim",
     "Simulation": "swarmtopo.sim",
+    "MotionParams": "swarmtopo.sim",
+    "Billiard": "swarmtopo.sim",
+    "RunAndTumble": "swarmtopo.sim",
+    "Brownian": "swarmtopo.sim",
+    "LevyWalk": "swarmtopo.sim",
+    "Flocking": "swarmtopo.sim",
     "read_log": "swarmtopo.io",
     "read_trace": "swarmtopo.io",
     "read_arena": "swarmtopo.io",

@@ -138,14 +138,16 @@ def _agents_option(value: int | None) -> int | None:
     return value
 
 
-def _check_option(hint: str, check, *args) -> None:
-    """Run a simulator check; its InputError becomes a usage error naming ``hint``."""
+def _check_option(hint: str, check, *args):
+    """Run a simulator check (returning what it returns); its InputError becomes a usage
+    error naming ``hint``."""
     from .errors import InputError
 
     try:
-        check(*args)
+        return check(*args)
     except InputError as exc:
-        got = "" if exc.value is None else f" (got {exc.value:g})"
+        value = exc.value
+        got = "" if value is None else f" (got {value:g})" if isinstance(value, (int, float)) else f" (got {value})"
         raise typer.BadParameter(exc.reason + got, param_hint=hint) from None
 
 
@@ -206,6 +208,24 @@ def simulate(
                                           help="Leash R (mm) of --beacon: agents farther are steered towards it."),
     leader_speed: Optional[float] = typer.Option(None, "--leader-speed", callback=_positive_option,
                                                  help="Speed (mm/s) of the leader of --beacon sweep (default 2)."),
+    motion: str = typer.Option("cockroach", "--motion",
+                               help="Motion model: cockroach (the paper's), billiard, run-and-tumble, brownian, levy or "
+                                    "flocking (docs/model.md in the source repository)."),
+    speed: Optional[float] = typer.Option(None, "--speed", callback=_positive_option,
+                                          help="Speed v (mm/s) of billiard, run-and-tumble, levy and flocking agents "
+                                               "(default 15)."),
+    tumble_rate: Optional[float] = typer.Option(None, "--tumble-rate", callback=_positive_option,
+                                                help="Run-and-tumble: tumbles per second (default 0.5)."),
+    diffusion: Optional[float] = typer.Option(None, "--diffusion", callback=_positive_option,
+                                              help="Brownian: diffusion coefficient D in mm^2/s (default 225)."),
+    levy_exponent: Optional[float] = typer.Option(None, "--levy-exponent", callback=_finite_option,
+                                                  help="Levy walk: step-length exponent mu in (1, 3] (default 2)."),
+    levy_min_step: Optional[float] = typer.Option(None, "--levy-min-step", callback=_positive_option,
+                                                  help="Levy walk: shortest step l_0 in mm (default 10)."),
+    align_radius: Optional[float] = typer.Option(None, "--align-radius", callback=_positive_option,
+                                                 help="Flocking: alignment radius in mm (default 30)."),
+    noise: Optional[float] = typer.Option(None, "--noise", callback=_finite_option,
+                                          help="Flocking: heading noise eta in [0, 2 pi] rad (default 1)."),
     overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar, no summary."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
@@ -217,8 +237,8 @@ def simulate(
     from .changing import ChangingArena, true_betti_text
     from .io.arenas import read_arena
     from .io.logs import write_log
-    from .sim import (MotionParams, SensingParams, check_run_size, check_static_time, check_time_step,
-                      simulate as run)
+    from .sim import SensingParams, check_run_size, check_static_time, check_time_step, simulate as run
+    from .sim.params import make_motion
     from .sim.simulate import check_duration
 
     _check_verbosity(quiet, verbose)
@@ -226,12 +246,17 @@ def simulate(
         raise typer.BadParameter("an --arena file has its own holes; drop --holes or --arena", param_hint="--holes")
     if static_time > 0 and static_fraction == 0:
         raise typer.BadParameter("the static agents' stop time needs --static-fraction > 0", param_hint="--static-time")
-    _check_option("--dt", check_time_step, dt, MotionParams(), SensingParams(r_d=rd))  # the motion simulate runs with
+    walk = _check_option("--motion", make_motion, motion, {
+        "speed": speed, "tumble_rate": tumble_rate, "diffusion": diffusion, "levy_exponent": levy_exponent,
+        "levy_min_step": levy_min_step, "align_radius": align_radius, "noise": noise})
+    _check_option("--dt", check_time_step, dt, walk, SensingParams(r_d=rd))  # the motion simulate runs with
     _check_option("--agents, --duration, --dt", check_run_size, agents, duration, dt)
     _check_option("--duration, --dt", check_duration, duration, dt)
     _check_option("--static-time", check_static_time, static_fraction, static_time, duration, dt)
     if (beacon is None) != (leash is None):
         raise typer.BadParameter("a leader needs both --beacon and --leash", param_hint="--beacon" if leash else "--leash")
+    if beacon is not None and motion != "cockroach":
+        raise typer.BadParameter(f"a leader steers the cockroach model only, not {motion} motion", param_hint="--beacon")
     if leader_speed is not None and beacon != "sweep":
         raise typer.BadParameter("sets the speed of --beacon sweep only (a path file gives its own speed)",
                                  param_hint="--leader-speed")
@@ -252,7 +277,7 @@ def simulate(
     start = time.perf_counter()
     with _staged_log(out_dir, overwrite) as stage:
         with _progress("simulating", quiet) as tick:
-            sim = run(world, agents, duration, dt=dt, sensing=SensingParams(r_d=rd), rng=seed,
+            sim = run(world, agents, duration, dt=dt, motion=walk, sensing=SensingParams(r_d=rd), rng=seed,
                       static_fraction=static_fraction, static_time=static_time, truth=truth,
                       trajectory_every=trajectories, progress=tick, **leader)
         if verbose:
@@ -425,6 +450,10 @@ def map_command(
     timeline_step: Optional[str] = _map_option(
         "timeline_step", "SECONDS|auto", "Seconds between the starts of the timeline's windows of its own (with "
                                          "this or --timeline-length; default half one)."),
+    recontacts: Optional[str] = _map_option(
+        "recontacts", "auto|merge|keep",
+        "A pair's repeated contact starts (contacts that flicker, as with diffusive or flocking agents): 'auto' "
+        "(default) merges each into the pair's first when the log's contacts flicker, 'merge' always, 'keep' never."),
     classifier: Optional[str] = typer.Option(
         None, "--classifier",
         help="Betti reader: default (tuned on the accuracy benchmark), trace (the same tuned on its logs read as "
@@ -461,7 +490,7 @@ def map_command(
                "wall_follow_weight": wall_follow_weight, "window_length": window_length,
                "window_encounters": window_encounters, "window_scales": window_scales, "window_step": window_step,
                "max_windows": max_windows, "landmark_bands": landmark_bands, "max_landmarks": max_landmarks,
-               "timeline_length": timeline_length, "timeline_step": timeline_step}
+               "timeline_length": timeline_length, "timeline_step": timeline_step, "recontacts": recontacts}
     if paper:
         given = [_option_name(name) for name in PAPER_EXCLUDES if options[name] is not None]
         if given or classifier is not None:
@@ -859,6 +888,36 @@ def bench_exploration(
     _bench_report("exploration", out_dir, store, quiet, verbose, markdown,
                   run=lambda tick: run_benchmark(store, quick=quick, scheduler=scheduler, workers=workers,
                                                  progress=tick))
+
+
+@bench_app.command("motion", epilog="Example: swarmtopo bench motion --quick --store motion.duckdb --workers 2  "
+                                    "(run it again after Ctrl-C: finished maps are kept)")
+def bench_motion(
+    quick: bool = typer.Option(False, "--quick", help="2 cases per cell instead of 12."),
+    split: str = typer.Option("reporting", "--split", help="reporting, or tuning (cases of their own seeds)."),
+    store: Path = typer.Option(Path("motion.duckdb"), "--store", help="DuckDB result store (resumable)."),
+    out_dir: Path = typer.Option(Path("motion"), "--out", help="Folder for motion.md and motion.json."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Address of an existing Dask scheduler."),
+    workers: Optional[int] = typer.Option(None, "--workers", min=1,
+                                          help="Worker processes of the local cluster (default: all cores)."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
+) -> None:
+    """How well swarms that are not cockroaches are mapped, from their encounters alone.
+
+    Simulates the accuracy benchmark's arenas (0-3 holes, 300 agents x 40 s) walked by
+    cockroach, billiard, run-and-tumble, Brownian, Levy-walk and flocking swarms with
+    parameters drawn per case; maps each log's encounters only (no status, no speeds,
+    no model named) on Dask; prints the share of exact maps per model and cell, the
+    regime each log was read as, and confident false holes.
+    """
+    from .experiments.motion_models import markdown, run_benchmark
+
+    if split not in ("reporting", "tuning"):
+        raise typer.BadParameter("must be reporting or tuning", param_hint="--split")
+    _bench_report("motion", out_dir, store, quiet, verbose, markdown,
+                  run=lambda tick: run_benchmark(store, quick=quick, split=split, scheduler=scheduler,
+                                                 workers=workers, progress=tick))
 
 
 @bench_app.command("timeline", epilog="Example: swarmtopo bench timeline --quick --store timeline.duckdb --workers 2  "

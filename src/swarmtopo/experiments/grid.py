@@ -32,6 +32,15 @@ Format (``examples/sweep-small.toml`` is a commented example)::
     leash = 0.0               # R, mm: a leader sweeps the arena's long axis once and agents are kept
                               # within R of it (swarmtopo.beacon.long_axis_track); 0 (default): no leader
     leader_speed = 2.0        # the leader's speed, mm/s (only with leash > 0)
+    motion = "cockroach"      # cockroach (the paper's, default) | billiard | run-and-tumble | brownian |
+                              # levy | flocking (swarmtopo.sim.params); their options (default: the model's):
+    speed = 15.0              # billiard, run-and-tumble, levy, flocking: mm/s
+    tumble_rate = 0.5         # run-and-tumble: tumbles per s
+    diffusion = 225.0         # brownian: D, mm^2/s
+    levy_exponent = 2.0       # levy: mu in (1, 3]
+    levy_min_step = 10.0      # levy: l_0, mm
+    align_radius = 30.0       # flocking: mm
+    noise = 1.0               # flocking: eta, rad
 
     [map]
     metric = "hybrid"         # plain | contracted | hybrid (default hybrid)
@@ -100,6 +109,7 @@ from ..readers.registry import PRESETS, load_classifier
 from ..errors import InputError, SwarmtopoError
 from ..io import read_arena
 from ..pipeline.config import OPTIONS, ConfigError, MapConfig, config_from_options
+from ..sim.params import MOTION_MODELS, MOTION_OPTIONS, make_motion
 from ..sim.simulate import check_parameters
 
 GENERATORS: dict[str, tuple[str, ...]] = {
@@ -218,6 +228,8 @@ PARAMS: tuple[Param, ...] = (
     Param("swarm", "static_time", 0.0, _number(0.0, strict=False), "DOUBLE"),
     Param("swarm", "leash", 0.0, _number(0.0, strict=False), "DOUBLE"),
     Param("swarm", "leader_speed", LEADER_SPEED, _number(0.0, strict=True), "DOUBLE"),
+    Param("swarm", "motion", "cockroach", _choice(tuple(MOTION_MODELS)), "TEXT"),
+    *(Param("swarm", name, None, _number(0.0, strict=name != "noise"), "DOUBLE") for name in MOTION_OPTIONS),
     *(Param("map", name, default, _option(name), sql) for name, default, sql in (
         ("metric", "hybrid", "TEXT"), ("hop_cost", "auto", "DOUBLE"), ("diffusion_time", "auto", "DOUBLE"),
         ("wall_follow_weight", MapConfig().wall_follow_weight, "DOUBLE"), ("window_length", "auto", "DOUBLE"),
@@ -465,8 +477,11 @@ def flat_columns(config: dict) -> dict[str, Any]:
 def job_simulation_args(swarm: dict[str, Any]) -> dict[str, Any]:
     """The swarm arguments of :func:`~swarmtopo.sim.simulate` (besides arena and rng) of a
     job's canonical ``[swarm]`` table."""
-    return {"n_agents": swarm["agents"], "duration": swarm["duration"],
+    args = {"n_agents": swarm["agents"], "duration": swarm["duration"],
             "static_fraction": swarm["static_fraction"], "static_time": swarm.get("static_time", 0.0)}
+    if "motion" in swarm:
+        args["motion"] = make_motion(swarm["motion"], {k: swarm[k] for k in MOTION_OPTIONS if k in swarm})
+    return args
 
 
 def job_map_config(mapping: dict[str, Any], seed: int | None = None) -> MapConfig:
@@ -558,6 +573,11 @@ def _canonical(point: dict, inputs: _InputFiles, fail):
     if point[("swarm", "leash")] > 0:
         swarm["leash"] = point[("swarm", "leash")]
         swarm["leader_speed"] = point[("swarm", "leader_speed")]
+    if point[("swarm", "motion")] != "cockroach":  # a cockroach job's config is as before walkers existed
+        swarm["motion"] = point[("swarm", "motion")]
+        fields = MOTION_MODELS[swarm["motion"]].__dataclass_fields__
+        swarm.update({name: point[("swarm", name)] for name, field in MOTION_OPTIONS.items()
+                      if field in fields and point[("swarm", name)] is not None})
 
     mapping = {name: point[("map", name)]
                for name in ("metric", "hop_cost", "diffusion_time", "wall_follow_weight", "window_length",
@@ -607,6 +627,10 @@ def _unused_reason(table: str, key: str, document: dict) -> str:
         return "not used: static_fraction is 0 (no agent stops for good)"
     if key == "leader_speed":
         return "not used: leash is 0 (no leader)"
+    if key in MOTION_OPTIONS:
+        users = [name for name, model in MOTION_MODELS.items()
+                 if MOTION_OPTIONS[key] in getattr(model, "__dataclass_fields__", {}) and name != "cockroach"]
+        return f"not used by this motion model (only by {', '.join(repr(u) for u in users)})"
     if key in ("window_step", "window_scales"):
         return 'not used: window_length is "none" (the whole log at once)'
     if key == "window_encounters":

@@ -74,6 +74,7 @@ _RESULTS = (
     ("confidence_betti0", "DOUBLE"), ("confidence_betti1", "DOUBLE"),
     ("snr_h1", "DOUBLE"), ("noise_power_h1", "DOUBLE"), ("lengths_h1", "DOUBLE[]"),
     ("diagrams", "BLOB"), ("diagrams_kept", "TEXT"), ("timeline", "JSON"), ("exploration", "JSON"),
+    ("motion_estimate", "JSON"),
     ("n_events", "INTEGER"), ("n_agents", "INTEGER"), ("n_regions", "INTEGER"), ("n_landmarks", "INTEGER"),
     ("t_simulate", "DOUBLE"), ("t_graph", "DOUBLE"), ("t_landmarks", "DOUBLE"), ("t_persistence", "DOUBLE"),
     ("t_classify", "DOUBLE"), ("t_total", "DOUBLE"),
@@ -82,7 +83,7 @@ _RESULTS = (
 )
 JOB_COLUMNS: tuple[tuple[str, str], ...] = (*_IDENTITY, *((p.name, p.sql) for p in PARAMS), *_RESULTS)
 """(name, DuckDB type) of every column of ``jobs``, in order."""
-JSON_COLUMNS = ("config", "versions", "timeline", "exploration")
+JSON_COLUMNS = ("config", "versions", "timeline", "exploration", "motion_estimate")
 """Columns holding JSON text; :func:`iter_jobs` returns them parsed."""
 RUN_COLUMNS = ("t_simulate", "t_graph", "t_landmarks", "t_persistence", "t_classify", "t_total",
                "versions", "worker", "finished_at")
@@ -524,7 +525,9 @@ def _tables(db) -> set[str]:
     return {name for (name,) in db.execute("SELECT table_name FROM information_schema.tables").fetchall()} & _TABLES
 
 
-NEW_COLUMNS = ("change", "change_time", "timeline", "length", "width", "leash", "leader_speed", "exploration")
+NEW_COLUMNS = ("change", "change_time", "timeline", "length", "width", "leash", "leader_speed", "exploration", "motion",
+               "speed", "tumble_rate", "diffusion", "levy_exponent", "levy_min_step", "align_radius", "noise",
+               "motion_estimate")
 """Columns added since stores had a runs table: a store without them gets them (NULL)
 when a sweep opens it, so its finished jobs are kept."""
 

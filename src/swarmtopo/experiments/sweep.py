@@ -46,7 +46,7 @@ from ..topology.persistence import snr
 from ..pipeline import MapConfig, map_encounters
 from ..pipeline.engine import POLL_SECONDS, connected_client, deferred_interrupt, local_client
 from ..pipeline.result import software_versions
-from ..viz.summary import exploration_json, timeline_json, window_json
+from ..viz.summary import exploration_json, motion_json, timeline_json, window_json
 from ..sim import simulate
 from .grid import (DEFAULT_JOB_TIMEOUT, KEEP_LEVELS, Job, case_streams, flat_columns, job_map_config,
                    job_simulation_args)
@@ -212,6 +212,7 @@ def run_job(job: Job, keep: str = "map") -> dict[str, Any]:
             diagrams=encode_regions(regions), diagrams_kept=keep,
             timeline=timeline_record(tmap.timeline, true_timeline, keep),
             exploration=exploration_record(tmap.exploration, arena, keep) if tmap.exploration else None,
+            motion_estimate=motion_json(tmap.motion),
             n_regions=len(tmap.regions), n_landmarks=sum(region["landmarks"] for region in regions),
             **{column: tmap.timings[stage] for stage, column in _STAGE_COLUMNS.items()},
         )

@@ -22,6 +22,9 @@ from ..errors import SwarmtopoError
 from ..metric.graph import METRICS
 from ..metric.landmarks import SUBSAMPLERS
 
+RECONTACTS = ("auto", "merge", "keep")
+"""``MapConfig.recontacts``: merge a flickering log's repeated contact starts (``auto``), always, or never."""
+
 MAX_HOP_COST, MAX_WALL_FOLLOW_WEIGHT = 1e9, 1e6
 """Bounds of the per-hop cost (s, about 30 years) and of the wall-following charge (s/s):
 far beyond any log, and far below where squared distances overflow in MDS."""
@@ -127,6 +130,10 @@ class MapConfig:
     timeline_step
         Seconds between the starts of the timeline's own windows; None (default) = half
         their length.
+    recontacts
+        What to do with a pair's repeated contact starts (:mod:`.motion`): ``auto``
+        (default) merges them when the log's contacts flicker (diffusive or flocking
+        agents), ``merge`` always, ``keep`` never (the paper).
     """
 
     metric: str = "hybrid"
@@ -153,6 +160,7 @@ class MapConfig:
     cycles: bool = True
     timeline_length: float | None = None
     timeline_step: float | None = None
+    recontacts: str = "auto"
 
     def __post_init__(self):
         for name in ("window_scales", "landmark_bands"):
@@ -210,6 +218,8 @@ class MapConfig:
                                              self.max_windows < len(scales)):
             bad("max_windows", f"must be a whole number, at least the number of window scales ({len(scales)}: one "
                                f"window per length), or None; got {self.max_windows}")
+        if self.recontacts not in RECONTACTS:
+            bad("recontacts", f"must be one of {', '.join(RECONTACTS)}, got {self.recontacts!r}")
         if self.maxdim not in (1, 2):
             bad("maxdim", f"must be 1 or 2, got {self.maxdim}")
         if self.embed_dim not in (0, 2, 3):
@@ -225,7 +235,7 @@ class MapConfig:
 
 
 PAPER_OPTIONS = {"hop_cost": 0.0, "diffusion_time": "none", "wall_follow_weight": "none", "window_length": "none",
-                 "window_scales": (1.0,), "landmark_bands": (1.0,)}
+                 "window_scales": (1.0,), "landmark_bands": (1.0,), "recontacts": "keep"}
 """The options of the paper's pipeline (no per-hop cost, no diffusive weights, wall
 following like any time, the whole log at once, whole-window landmarks), read with the
 ``paper`` reader (``swarmtopo map --paper``)."""
@@ -384,6 +394,7 @@ OPTIONS: dict[str, Option] = {option.name: option for option in (
     Option("timeline_length", _number(0.0, strict=True), _SECONDS),
     Option("timeline_step", _number(0.0, strict=True), {"auto": None}),
     Option("seed", _integer(0)),
+    Option("recontacts", _choice(RECONTACTS)),
 )}
 """Every option users may set by name, with its parser."""
 

@@ -33,12 +33,14 @@ from ..metric.graph import weighted_chains
 from ..metric.landmarks import MIN_LANDMARKS
 from ..readers.base import BettiReader
 from ..readers.beta0 import shipped_beta0_model
+from ..readers.recalibrated import Recalibrated, flicker_recalibration
 from ..readers.registry import load_classifier, shipped_reader_for
 from ..topology.cycles import region_cycles
 from ..topology.embed import mds
 from ..topology.persistence import Diagram, rips_persistence
 from .config import MapConfig
 from .engine import engine_for
+from .motion import estimate_motion, motion_warnings
 from .exploration import MAX_EXPLORATION_WINDOWS, exploration_windows, leash_of, stitch
 from .regions import MIN_REGION_AGENTS, split_regions
 from .result import RegionMap, RegionScales, TimelineWindow, TopologicalMap, WindowMap, software_versions
@@ -95,6 +97,10 @@ def map_encounters(
     """
     config = (config or MapConfig()).validate()
     reader = reader or load_classifier(shipped_reader_for(log))
+    motion, log = estimate_motion(log, config.recontacts, config.window)
+    if motion.regime == "flickering" and motion.merged and getattr(reader, "shipped_preset", None):
+        reader = flicker_recalibration(reader.shipped_preset, reader) or reader
+    recalibrated = isinstance(reader, Recalibrated)
     settings = resolve(log, config, reader)
     leash = leash_of(log)
     span = (float(settings.times[0]), float(settings.times[-1]))
@@ -151,13 +157,15 @@ def map_encounters(
     length, step = timeline_settings(timeline_config, settings.window_length[0])
     timeline = build_timeline(timeline_windows, length, step, betti, confidence, log,
                               note=None if timeline_windows else no_timeline_note(timeline_config, length))
-    warnings = silence_warnings(settings.times, settings.window_length[0]) + _extrapolation_warnings(betti)
+    warnings = (motion_warnings(motion, recalibrated) + silence_warnings(settings.times, settings.window_length[0])
+                + _extrapolation_warnings(betti))
     exploration = None
     if leash is not None and betti.get(1) is not None:
         exploration = stitch(timeline.windows, log.beacon, leash, length, step, len(regions), log.meta, span)
         if exploration.betti[1] is not None:  # the global map's count is the answer
             betti[1], confidence[1] = exploration.betti[1], None
-            warnings = silence_warnings(settings.times, settings.window_length[0])
+            warnings = (motion_warnings(motion, recalibrated)
+                        + silence_warnings(settings.times, settings.window_length[0]))
     elif (log.beacon is None) != ("leash" not in log.meta):
         warnings.append("the log has " + ("a leader's track (beacon.csv) but no 'leash' in meta.json"
                                           if log.beacon is not None else "a 'leash' in meta.json but no beacon.csv")
@@ -184,6 +192,7 @@ def map_encounters(
         software=software_versions(),
         timeline=timeline,
         exploration=exploration,
+        motion=motion,
     )
 
 

@@ -19,6 +19,7 @@ from ..topology.cycles import Cycle
 from ..topology.embed import Embedding
 from ..topology.persistence import Diagram, PersistenceResult
 from .config import WHOLE_LOG, MapConfig
+from .motion import MotionEstimate
 
 
 @dataclass(frozen=True)
@@ -243,6 +244,7 @@ class TopologicalMap:
     contact_trace: bool = False  # the log has no status changes: a contact trace
     timeline: Timeline | None = None  # Betti numbers over sliding windows, change points (pipeline.timeline)
     exploration: Exploration | None = None  # the global map of a beacon-led log (pipeline.exploration)
+    motion: MotionEstimate | None = None  # what the encounters say about the agents' motion (pipeline.motion)
 
     @property
     def warnings(self) -> list[str]:

@@ -59,7 +59,9 @@ def load_classifier(name: str | Path) -> BettiReader:
                              file=str(path), value=str(name))
         source, obj = str(path), read_json(path)
     check_format(obj, tuple(READERS), "swarmtopo classifier", source)
-    return READERS[obj["format"]].from_json(obj, source=source)
+    reader = READERS[obj["format"]].from_json(obj, source=source)
+    reader.shipped_preset = str(name) if str(name) in PRESETS else None  # what readers.recalibrated fits are for
+    return reader
 
 
 @lru_cache(maxsize=None)

@@ -109,6 +109,13 @@ reference-count updates per call.  ``agents[i]`` is a view in numba and in numpy
 
 def new_swarm(xy: np.ndarray, model: Model, rng: np.random.Generator) -> np.ndarray:
     """Agents at ``xy`` (N, 2), state RW, armed, random heading, fresh timers."""
+    agents = blank_swarm(xy)
+    init_swarm(agents, model, rng)
+    return agents
+
+
+def blank_swarm(xy: np.ndarray) -> np.ndarray:
+    """Agent records at ``xy`` (N, 2): state RW, mode free, armed, nothing drawn yet."""
     agents = np.zeros(len(xy), AGENT_DTYPE)
     agents["x"], agents["y"] = xy[:, 0], xy[:, 1]
     agents["state"] = agents["resume_state"] = RW
@@ -116,7 +123,6 @@ def new_swarm(xy: np.ndarray, model: Model, rng: np.random.Generator) -> np.ndar
     agents["armed"] = 1
     agents["wf_dir"] = 1
     agents["reported"] = -1
-    init_swarm(agents, model, rng)
     return agents
 
 

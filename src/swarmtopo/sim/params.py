@@ -25,6 +25,7 @@ and ``tau_exit`` and means "never" (no natural stops, wall following never exits
 
 from __future__ import annotations
 
+import math
 import operator
 from dataclasses import dataclass
 
@@ -159,3 +160,194 @@ class Command:
     def mode(self) -> int:
         """Kernel mode code of the behaviour."""
         return BEHAVIOURS.index(self.behaviour)
+
+
+@dataclass(frozen=True)
+class Billiard:
+    """Billiard motion: straight lines at a constant speed, specular reflection off walls.
+
+    The only randomness is each agent's first heading.  Cheap robots that drive until
+    they bump move like this.
+
+    Attributes
+    ----------
+    speed : float
+        v, mm/s.
+    """
+
+    speed: float = 15.0
+    name = "billiard"
+
+    def __post_init__(self):
+        object.__setattr__(self, "speed", positive("Billiard.speed", self.speed))
+
+
+@dataclass(frozen=True)
+class RunAndTumble:
+    """Run-and-tumble motion (E. coli, Kilobots): straight runs at speed v ended by
+    instantaneous tumbles at rate lambda to a uniform new heading; walls reflect.
+
+    Runs last Exp(1 / lambda) (mean run length v / lambda), and in open space the mean
+    squared displacement is MSD(t) = 2 v^2 / lambda^2 (lambda t - 1 + exp(-lambda t)).
+
+    Attributes
+    ----------
+    speed : float
+        v, mm/s.
+    tumble_rate : float
+        lambda, tumbles per second.
+    """
+
+    speed: float = 15.0
+    tumble_rate: float = 0.5
+    name = "run-and-tumble"
+
+    def __post_init__(self):
+        object.__setattr__(self, "speed", positive("RunAndTumble.speed", self.speed))
+        object.__setattr__(self, "tumble_rate", positive("RunAndTumble.tumble_rate", self.tumble_rate))
+
+
+@dataclass(frozen=True)
+class Brownian:
+    """Brownian (diffusive) motion: independent Gaussian increments, MSD(t) = 4 D t in
+    open space; walls reflect.
+
+    Each time step dt is walked in ``BROWNIAN_SUBSTEPS`` Gaussian sub-steps of variance
+    2 D dt / n per axis, each cut into straight pieces of at most r_d / 4 reflected off
+    the walls, so a wall is never crossed whatever the increment.
+
+    Attributes
+    ----------
+    diffusion : float
+        D, mm^2/s.
+    """
+
+    diffusion: float = 225.0
+    name = "brownian"
+
+    def __post_init__(self):
+        object.__setattr__(self, "diffusion", positive("Brownian.diffusion", self.diffusion))
+
+
+@dataclass(frozen=True)
+class LevyWalk:
+    """Lévy walk: straight steps at speed v with heavy-tailed lengths, P(L > l) =
+    (l / l_0)^(1 - mu) for l >= l_0, then a uniform new heading; walls reflect (a
+    step goes on after a reflection until its length is walked).
+
+    1 < mu <= 3: mu < 2 has steps of infinite mean (ballistic-like), mu -> 3 tends to
+    diffusion; in between the MSD grows like t^(4 - mu) (superdiffusive).
+
+    Attributes
+    ----------
+    speed : float
+        v, mm/s.
+    exponent : float
+        mu, the step-length exponent (density ~ l^-mu).
+    min_step : float
+        l_0, the shortest step, mm.
+    """
+
+    speed: float = 15.0
+    exponent: float = 2.0
+    min_step: float = 10.0
+    name = "levy"
+
+    def __post_init__(self):
+        object.__setattr__(self, "speed", positive("LevyWalk.speed", self.speed))
+        object.__setattr__(self, "min_step", positive("LevyWalk.min_step", self.min_step))
+        mu = positive("LevyWalk.exponent", self.exponent)
+        if not 1.0 < mu <= 3.0:
+            raise InputError("LevyWalk.exponent must be in (1, 3]", value=self.exponent)
+        object.__setattr__(self, "exponent", mu)
+
+
+@dataclass(frozen=True)
+class Flocking:
+    """Vicsek flocking: constant speed v; at every time step each moving agent takes the
+    mean heading of the moving agents within the alignment radius (itself included)
+    plus noise U[-eta/2, eta/2]; walls reflect.  Walls do not hide neighbours.
+
+    The alignment happens once per time step dt (Vicsek et al. 1995, with their Delta t
+    = dt).  Low noise orders the swarm (order parameter phi = |mean unit velocity| -> 1),
+    eta = 2 pi leaves it disordered (phi ~ 1 / sqrt(N)).
+
+    Attributes
+    ----------
+    speed : float
+        v, mm/s.
+    radius : float
+        Alignment radius, mm.
+    noise : float
+        eta in [0, 2 pi], rad.
+    """
+
+    speed: float = 15.0
+    radius: float = 30.0
+    noise: float = 1.0
+    name = "flocking"
+
+    def __post_init__(self):
+        object.__setattr__(self, "speed", positive("Flocking.speed", self.speed))
+        object.__setattr__(self, "radius", positive("Flocking.radius", self.radius))
+        eta = non_negative("Flocking.noise", self.noise)
+        if eta > 2 * math.pi:
+            raise InputError("Flocking.noise must be in [0, 2 pi] rad", value=self.noise)
+        object.__setattr__(self, "noise", eta)
+
+
+BROWNIAN_SUBSTEPS = 4
+"""Gaussian sub-steps per time step of :class:`Brownian` motion."""
+
+WALKERS = (Billiard, RunAndTumble, Brownian, LevyWalk, Flocking)
+"""Motion models beside the paper's cockroach (:class:`MotionParams`)."""
+MOTION_MODELS: dict[str, type] = {"cockroach": MotionParams, **{m.name: m for m in WALKERS}}
+"""Every motion model by the name the CLI, sweeps and meta.json use."""
+
+
+def motion_name(motion) -> str:
+    """The name of a motion model instance (``"cockroach"`` for :class:`MotionParams`)."""
+    return "cockroach" if isinstance(motion, MotionParams) else motion.name
+
+
+def top_speed(motion, dt: float) -> float:
+    """The farthest an agent moves in one time step at the model's speed, mm (for a
+    Brownian agent its root-mean-square displacement sqrt(4 D dt))."""
+    if isinstance(motion, MotionParams):
+        return max(motion.v_c, motion.v_p) * dt
+    if isinstance(motion, Brownian):
+        return math.sqrt(4.0 * motion.diffusion * dt)
+    return motion.speed * dt
+
+
+MOTION_OPTIONS: dict[str, str] = {"speed": "speed", "tumble_rate": "tumble_rate", "diffusion": "diffusion",
+                                  "levy_exponent": "exponent", "levy_min_step": "min_step",
+                                  "align_radius": "radius", "noise": "noise"}
+"""Option name (``simulate --levy-exponent``, a sweep's ``[swarm] levy_exponent``) -> the
+walker field it sets."""
+
+
+def make_motion(name: str, options: dict[str, float | None] | None = None):
+    """The motion model ``name`` (a key of :data:`MOTION_MODELS`) with the given options
+    (keys of :data:`MOTION_OPTIONS`; None leaves a default).
+
+    Raises
+    ------
+    InputError
+        For an unknown model, or an option the model does not have.
+    """
+    if name not in MOTION_MODELS:
+        raise InputError(f"unknown motion model; expected one of {', '.join(MOTION_MODELS)}", value=name)
+    model = MOTION_MODELS[name]
+    given = {k: v for k, v in (options or {}).items() if v is not None}
+    fields = {f for f in getattr(model, "__dataclass_fields__", {})}
+    kwargs = {}
+    for option, value in given.items():
+        field = MOTION_OPTIONS.get(option)
+        if field is None or field not in fields or model is MotionParams:
+            has = [o for o, f in MOTION_OPTIONS.items() if f in fields and model is not MotionParams]
+            raise InputError(f"{option.replace('_', '-')} is not an option of {name} motion"
+                             + (f" (it has {', '.join(o.replace('_', '-') for o in has)})" if has else
+                                " (the cockroach's parameters are the paper's defaults)"), value=value)
+        kwargs[field] = value
+    return model(**kwargs)

@@ -41,8 +41,9 @@ from . import leash as _leash
 from . import commands as _commands
 from . import motion as _motion
 from . import sensing as _sensing
+from . import walkers as _walkers
 from . import walls as _walls
-from .params import STATIC, Command, MotionParams, SensingParams
+from .params import STATIC, WALKERS, Brownian, Command, MotionParams, SensingParams, motion_name, top_speed
 
 TIME_DECIMALS = 9
 MAX_AGENTS = 100_000
@@ -115,9 +116,13 @@ def simulate(
         Simulated time, s: a whole number K >= 1 of time steps dt (to a relative 1e-9).
     dt : float
         Time step, s; must satisfy max(v_c, v_p) dt <= r_d / 4.
-    motion, sensing : MotionParams, SensingParams
-        Model parameters (paper defaults: v_c, l*, v_p, tau_stop, p_sh, tau_s, tau_l,
-        tau_exit; r_d).
+    motion : MotionParams or one of :data:`.params.WALKERS`
+        The motion model: the paper's cockroach (:class:`MotionParams`, its defaults
+        v_c, l*, v_p, tau_stop, p_sh, tau_s, tau_l, tau_exit) or :class:`Billiard`,
+        :class:`RunAndTumble`, :class:`Brownian`, :class:`LevyWalk`, :class:`Flocking`
+        (:mod:`.walkers`; they never wall-follow, so no ``"WF"`` command and no leader).
+    sensing : SensingParams
+        r_d and what blocks a contact.
     commands : sequence of Command
         Base-station commands, applied in time order (ties: given order); none may
         come after the last step t_K = K dt.
@@ -142,8 +147,10 @@ def simulate(
     -------
     Simulation
         ``log.meta`` holds ``format`` (:data:`swarmtopo.log.LOG_FORMAT`), ``version``,
-        ``units``, r_d, v_c, v_p, ``duration`` (t_K), dt, ``agent_count``, ``seed``
-        and ``simulation`` (all parameters; infinities written as ``"inf"``).
+        ``units``, r_d, v_c, v_p (the cockroach's speeds; a walker's speed as both, none
+        for Brownian motion), ``duration`` (t_K), dt, ``agent_count``, ``seed`` and
+        ``simulation`` (all parameters, the model's name as ``motion_model``;
+        infinities written as ``"inf"``).
 
     Raises
     ------
@@ -159,6 +166,8 @@ def simulate(
         if not isinstance(beacon, BeaconTrack):
             raise InputError(f"beacon must be a BeaconTrack, got {type(beacon).__name__}")
         leash = positive("leash", leash)
+        if not isinstance(motion, MotionParams):
+            raise InputError(f"a leader steers the cockroach model only, not {motion_name(motion)} motion")
     commands = list(commands)
     if static_fraction > 0:
         commands.append(Command(static_time, "static", fraction=static_fraction))
@@ -172,11 +181,17 @@ def simulate(
     n = int(n_agents)
     n_steps = _n_steps(duration, dt)
     r_d = sensing.r_d
-    max_step = max(motion.v_c, motion.v_p) * dt
+    walker, commanded = None, motion
+    if isinstance(motion, MotionParams):
+        max_step = top_speed(motion, dt)
+    else:  # walkers move in straight pieces of at most r_d / 4 (check_time_step bounds the steps)
+        max_step = r_d / 4
+        walker = _walkers.make_walker(motion, dt, max_step)
+        commanded = _walkers.command_model(motion, r_d, dt)
     reach = r_d + 3 * max_step
     free = arena.at(0.0) if isinstance(arena, ChangingArena) else arena
     walls = _walls.build_wall_grid(free.boundary_segments, free.bounds, cell=r_d, reach=reach)
-    model = _motion.make_model(motion, r_d, dt)
+    model = _motion.make_model(commanded, r_d, dt)
     start_area = None
     if beacon is not None:
         bx, by = (float(c[0]) for c in beacon.position([0.0]))
@@ -184,7 +199,12 @@ def simulate(
         if start_area.intersection(free.geometry).area <= 0:
             raise InputError(f"the leader's first position ({bx:g}, {by:g}) mm is not within the leash R = {leash:g} mm "
                              "of the arena's free space: the agents start within R of it")
-    agents = _motion.new_swarm(free.sample_uniform(n, gen, clearance=_walls.WALL_EPS, within=start_area), model, gen)
+    xy = free.sample_uniform(n, gen, clearance=_walls.WALL_EPS, within=start_area)
+    if walker is None:
+        agents = _motion.new_swarm(xy, model, gen)
+    else:
+        agents = _motion.blank_swarm(xy)
+        _walkers.init_walkers(agents, walker, gen)
     stimulated, stimulus = 0, np.zeros(n, np.bool_)
     tracker = _sensing.EncounterTracker(n, r_d, walls if sensing.walls_block else None,
                                         log_initial_contacts=sensing.log_initial_contacts)
@@ -227,7 +247,10 @@ def simulate(
         if beacon is not None:
             bx, by = beacon.position(t)
             stimulated += _leash.steer(agents, stimulus, float(bx), float(by), leash, model, walls, gen)
-        n_changed = _motion.step_swarm(agents, model, walls, gen, k < n_steps, changed)
+        if walker is None:
+            n_changed = _motion.step_swarm(agents, model, walls, gen, k < n_steps, changed)
+        else:
+            n_changed = _walkers.step_walkers(agents, walker, walls, gen, k < n_steps, changed)
         if n_changed:
             who = changed[:n_changed].copy()
             status.append((t, who, agents["state"][who]))
@@ -268,14 +291,15 @@ def _check_inputs(arena, n_agents, duration, dt, motion, sensing, commands, stat
 
 
 def check_parameters(n_agents: int, duration: float, *, dt: float = DT,
-                     motion: MotionParams = MotionParams(), sensing: SensingParams = SensingParams(),
+                     motion=MotionParams(), sensing: SensingParams = SensingParams(),
                      commands: Sequence[Command] = (), static_fraction: float = 0.0,
                      static_time: float = 0.0) -> None:
     """:func:`simulate`'s checks of the swarm's parameters (all but the arena, rng and
     outputs), without running it: InputError on a bad one."""
     positive_int("n_agents", n_agents)
-    if not isinstance(motion, MotionParams):
-        raise InputError(f"motion must be a MotionParams, got {type(motion).__name__}")
+    if not isinstance(motion, (MotionParams, *WALKERS)):
+        raise InputError("motion must be a MotionParams or one of " + ", ".join(m.__name__ for m in WALKERS)
+                         + f", got {type(motion).__name__}")
     if not isinstance(sensing, SensingParams):
         raise InputError(f"sensing must be a SensingParams, got {type(sensing).__name__}")
     check_time_step(dt, motion, sensing)
@@ -288,6 +312,11 @@ def check_parameters(n_agents: int, duration: float, *, dt: float = DT,
         if not isinstance(c, Command):
             raise InputError(f"commands must be Command objects, got {type(c).__name__}", value=c)
     _commands.check_command_agents(commands, int(n_agents))
+    if not isinstance(motion, MotionParams):
+        for c in commands:
+            if c.behaviour == "WF":
+                raise InputError(f"a 'WF' command needs the cockroach model: {motion_name(motion)} agents do not "
+                                 f"follow walls", value=c.time)
     check_static_time(static_fraction, static_time, duration, dt)
     end = _end_time(duration, dt)
     for c in commands:
@@ -296,16 +325,26 @@ def check_parameters(n_agents: int, duration: float, *, dt: float = DT,
                              f"t = {end:g} s", value=c.time)
 
 
-def check_time_step(dt: float, motion: MotionParams, sensing: SensingParams) -> None:
+def check_time_step(dt: float, motion, sensing: SensingParams) -> None:
     """InputError unless dt > 0 and an agent moves at most r_d / 4 per step (else contacts
-    and walls could be stepped over)."""
+    and walls could be stepped over): at its top speed, or for Brownian motion by its
+    root-mean-square displacement sqrt(4 D dt), which may reach r_d / 2 (its path is
+    rough at every scale, and the walls are checked piece by piece)."""
     positive("dt", dt)
-    speed = max(motion.v_c, motion.v_p)
-    if speed * dt > sensing.r_d / 4:
+    step = top_speed(motion, dt)
+    if isinstance(motion, Brownian):
+        if step > sensing.r_d / 2:
+            raise InputError(
+                f"time step too coarse: Brownian agents move sqrt(4 D dt) = {step:g} mm per step (root mean "
+                f"square), more than r_d / 2 = {sensing.r_d / 2:g} mm, so contacts could be stepped over; use "
+                f"dt <= {sensing.r_d ** 2 / (16 * motion.diffusion):g} s", value=dt)
+        return
+    if step > sensing.r_d / 4:
+        what = "max(v_c, v_p) * dt" if isinstance(motion, MotionParams) else "speed * dt"
         raise InputError(
-            f"time step too coarse: agents move max(v_c, v_p) * dt = {speed * dt:g} mm per step, more than "
+            f"time step too coarse: agents move {what} = {step:g} mm per step, more than "
             f"r_d / 4 = {sensing.r_d / 4:g} mm, so contacts and walls could be stepped over; "
-            f"use dt <= {sensing.r_d / (4 * speed):g} s", value=dt)
+            f"use dt <= {sensing.r_d * dt / (4 * step):g} s", value=dt)
 
 
 def check_run_size(n_agents: int, duration: float, dt: float) -> None:
@@ -360,13 +399,17 @@ def _meta(arena, n, n_steps, dt, motion, sensing, commands, static_fraction, sta
         "static_time": float(static_time),
         "arena_betti": list(arena.betti),
     }
+    speeds = {"v_c": motion.v_c, "v_p": motion.v_p} if isinstance(motion, MotionParams) else {}
+    if not isinstance(motion, MotionParams):  # a cockroach log has no model name (as before walkers existed)
+        provenance["motion_model"] = motion_name(motion)
+        if hasattr(motion, "speed"):
+            speeds = {"v_c": motion.speed, "v_p": motion.speed}
     return jsonable({
         "format": LOG_FORMAT,
         "version": __version__,
         "units": {"time": "s", "length": "mm"},
         "r_d": sensing.r_d,
-        "v_c": motion.v_c,
-        "v_p": motion.v_p,
+        **speeds,
         "duration": round(n_steps * dt, TIME_DECIMALS),
         "dt": float(dt),
         "agent_count": n,
@@ -421,7 +464,7 @@ def interpreted_kernels():
     Python source function, so a simulation is a plain per-agent Python loop of the
     same model with the same neighbour search.  Not thread-safe.
     """
-    modules = [_walls, _motion, _commands, _sensing, _leash]
+    modules = [_walls, _motion, _commands, _sensing, _leash, _walkers]
     saved = []
     for module in modules:
         for name, obj in vars(module).items():

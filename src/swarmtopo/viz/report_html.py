@@ -194,6 +194,9 @@ def _verdict_section(doc: dict, arena, true_timeline: list | None = None) -> str
              if doc["log"].get("contact_trace") else "holes (obstacles)")
     lines.append(f'<p class="note">&beta;<sub>0</sub> counts connected regions, &beta;<sub>1</sub> {holes}; '
                  "a confidence is the calibrated probability that the number is right.</p>")
+    if doc.get("motion"):
+        lines.append(f'<p class="motion" data-regime="{doc["motion"]["regime"]}">'
+                     f'{html.escape(doc["motion"]["summary"])}</p>')
     for warning in doc["warnings"]:
         lines.append(f'<p class="warning">warning: {html.escape(warning)}</p>')
     for small in doc["too_little_data"]:

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from .._json import jsonable
+from ..pipeline.motion import MotionEstimate
 from ..pipeline.result import Exploration, RegionMap, Timeline, TopologicalMap, WindowMap
 from ..readers.beta0 import BETA0_DEFINITION
 from ..readers.ratio import RESOLUTION_CAP, below_full_resolution, resolution
@@ -71,6 +72,7 @@ def map_json(tmap: TopologicalMap) -> dict[str, Any]:
         "too_little_data": tmap.too_little_data,
         "timeline": None if tmap.timeline is None else timeline_json(tmap.timeline),
         "exploration": None if tmap.exploration is None else exploration_json(tmap.exploration),
+        "motion": None if tmap.motion is None else motion_json(tmap.motion),
         "beta0_evidence": None if tmap.beta0_evidence is None else {**tmap.beta0_evidence.to_json(),
                                                                       "definition": BETA0_DEFINITION},
         "params": {**jsonable(asdict(tmap.config)), "hop_cost_used": tmap.hop_cost[0],
@@ -83,6 +85,13 @@ def map_json(tmap: TopologicalMap) -> dict[str, Any]:
         "timings": {k: round(v, 6) for k, v in tmap.timings.items()},
         "software": {**tmap.software, "persistence_backend": tmap.diagram.backend},
     }
+
+
+def motion_json(motion: MotionEstimate) -> dict[str, Any]:
+    """map.json's ``motion``: what the encounters say about the agents' motion."""
+    return {"regime": motion.regime, "summary": motion.describe(), "recontact_share": motion.recontact_share,
+            "median_gap": motion.median_gap, "encounter_rate": motion.encounter_rate,
+            "partners_per_agent": motion.partners_per_agent, "merged": motion.merged}
 
 
 def timeline_json(timeline: Timeline) -> dict[str, Any]:
