@@ -24,8 +24,8 @@ import numpy as np
 
 from ..arena import HOLE_SHAPES, OUTER_SHAPES
 from .accuracy import HELD_OUT_FAMILY, SCALE_RANGE, TRACE_PIPELINE, Rate, brier_gain, failures_text, percent_text
-from .grid import Job, canonical_json, suite_case_seed
-from .sweep import first_placeable, run_cases
+from .grid import Job, suite_case_seed
+from .sweep import run_cases, suite_case, suite_jobs
 
 SUITE = "swarmtopo-motion/1"
 MODELS = ("cockroach", "billiard", "run-and-tumble", "brownian", "levy", "flocking")
@@ -63,14 +63,9 @@ class Cell:
 CELLS: tuple[Cell, ...] = tuple(Cell(m, h) for m in MODELS for h in HOLES)
 
 
-def case_seed(cell: Cell, split: str, index: int, attempt: int = 0) -> int:
-    """64-bit seed of one case, from (SUITE, cell, split, index, attempt)."""
-    return suite_case_seed(SUITE, cell.name, split, index, attempt)
-
-
 def case_config(cell: Cell, split: str, index: int, attempt: int = 0) -> dict[str, Any]:
     """The ``[arena]`` and ``[swarm]`` tables of one case (module docstring)."""
-    rng = np.random.default_rng(case_seed(cell, split, index, attempt))
+    rng = np.random.default_rng(suite_case_seed(SUITE, cell.name, split, index, attempt))
     families = [s for s in HOLE_SHAPES if split == "reporting" or s != HELD_OUT_FAMILY]
     arena = {"generator": "random", "holes": cell.holes, "shapes": [families[int(rng.integers(len(families)))]],
              "scale": float(np.round(rng.uniform(*SCALE_RANGE), 4)),
@@ -85,23 +80,13 @@ def case_config(cell: Cell, split: str, index: int, attempt: int = 0) -> dict[st
 
 def case(cell: Cell, split: str, index: int) -> tuple[dict[str, Any], int]:
     """(config tables, case seed) of a case whose holes fit."""
-    return first_placeable(lambda attempt: (case_config(cell, split, index, attempt),
-                                            case_seed(cell, split, index, attempt)),
-                           MAX_ATTEMPTS, f"{SUITE}: {cell.name} case {index}")
+    return suite_case(SUITE, cell, split, index, case_config, MAX_ATTEMPTS)
 
 
 def jobs(split: str, per_cell: int, cells=CELLS, pipeline: dict[str, Any] = TRACE_PIPELINE) -> list[Job]:
     """The jobs of ``per_cell`` cases of every cell, mapped by ``pipeline`` (default: the
     default pipeline on the encounters only)."""
-    out = []
-    for cell in cells:
-        for index in range(per_cell):
-            config, seed = case(cell, split, index)
-            config["map"] = {"subsample": "maxmin", "landmarks": "auto", "max_landmarks": 400, "maxdim": 1,
-                             **pipeline}
-            out.append(Job(sweep=f"motion-{split}", config_json=canonical_json(config), replicate=index,
-                           salt=f"{SUITE}/{split}/{cell.name}", case_seed=seed))
-    return out
+    return suite_jobs(SUITE, "motion", split, per_cell, cells, case, pipeline)
 
 
 def records(rows) -> list[dict[str, Any]]:
@@ -133,8 +118,10 @@ def table(recs: list[dict[str, Any]]) -> dict[str, Any]:
         p = np.array([r["confidence"] for r in scored])
         y = np.array([r["beta1_exact"] for r in scored], dtype=float)
         gain = float(brier_gain(p, y)) if len(scored) >= 2 else None
+        rho = [r["recontact_share"] for r in subset if r["recontact_share"] is not None]
         return {"logs": len(subset), "exact": Rate(sum(r["exact"] for r in subset), len(subset)).to_json(),
                 "flickering": sum(r["regime"] == "flickering" for r in subset),
+                "recontact_share": [min(rho), max(rho)] if rho else None,
                 "confident_false_holes": sum(r["holes"] == 0 and r["estimated"] is not None and r["estimated"][1] > 0
                                              and r["confidence"] is not None and r["confidence"] > CONFIDENT
                                              for r in subset),
@@ -165,11 +152,12 @@ def markdown(summary: dict[str, Any], command: str) -> str:
 
     def row(name, t):
         conf = "–" if t["mean_confidence"] is None else f"{t['mean_confidence']:.2f}"
-        return (f"| {name} | {t['logs']} | {percent_text(t['exact'])} | {t['flickering']} | "
+        rho = "–" if t["recontact_share"] is None else "{:.2f}-{:.2f}".format(*t["recontact_share"])
+        return (f"| {name} | {t['logs']} | {percent_text(t['exact'])} | {t['flickering']} | {rho} | "
                 f"{t['confident_false_holes']} | {conf} | {gain(t['brier_gain'])} |")
 
-    head = ["| {} | logs | exact (beta_0, beta_1) | read as flickering | confident false holes | mean confidence "
-            "| Brier gain |", "|---|---|---|---|---|---|---|"]
+    head = ["| {} | logs | exact (beta_0, beta_1) | read as flickering | re-contact share | confident false holes "
+            "| mean beta_1 confidence | Brier gain |", "|---|---|---|---|---|---|---|---|"]
     n, seconds = summary["budget"]
     lines = [f"# Motion benchmark ({summary['suite']}, {summary['split']} cases)", "",
              f"`{command}`: {summary['cases_per_cell']} cases per cell, {n} agents x {seconds:g} s, the encounters "
@@ -177,6 +165,9 @@ def markdown(summary: dict[str, Any], command: str) -> str:
              head[0].format("model"), head[1]]
     lines += [row(name, t) for name, t in summary["table"]["models"].items()]
     lines.append(row("**all**", summary["table"]["overall"]))
+    lines += ["", f"Confident false holes: hole-free arenas read with a hole at a beta_1 confidence above {CONFIDENT:g}. "
+              "Brier gain: the Brier score of a constant equal to the share of exact beta_1 minus that of the beta_1 "
+              "confidence (above 0: the confidence tells right maps from wrong ones better than the constant)."]
     lines += ["", head[0].format("cell"), head[1]]
     lines += [row(name, t) for name, t in summary["table"]["cells"].items()]
     return "\n".join(lines + failures_text(summary["records"], "wrong")) + "\n"

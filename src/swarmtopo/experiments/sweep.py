@@ -48,8 +48,8 @@ from ..pipeline.engine import POLL_SECONDS, connected_client, deferred_interrupt
 from ..pipeline.result import software_versions
 from ..viz.summary import exploration_json, motion_json, timeline_json, window_json
 from ..sim import simulate
-from .grid import (DEFAULT_JOB_TIMEOUT, KEEP_LEVELS, Job, case_streams, flat_columns, job_map_config,
-                   job_simulation_args)
+from .grid import (DEFAULT_JOB_TIMEOUT, KEEP_LEVELS, Job, canonical_json, case_streams, flat_columns, job_map_config,
+                   job_simulation_args, suite_case_seed)
 from .isolation import JobProcess, one_line
 from .store import JOB_COLUMNS, LOCK_WAIT, FailureGroup, ResultStore, encode_regions, group_failures, utcnow
 
@@ -104,6 +104,35 @@ def first_placeable(draw: Callable[[int], tuple[dict[str, Any], int]], attempts:
             continue
         return config, seed
     raise SwarmtopoError(f"no placeable arena for {what} in {attempts} attempts")
+
+
+SUITE_MAP = {"subsample": "maxmin", "landmarks": "auto", "max_landmarks": 400, "maxdim": 1}
+"""The ``[map]`` keys every benchmark suite's jobs share (the pipeline adds the rest)."""
+
+
+def suite_case(suite: str, cell, split: str, index: int, case_config: Callable[..., dict[str, Any]],
+               attempts: int) -> tuple[dict[str, Any], int]:
+    """(config tables, case seed) of case ``index`` of ``cell`` of a frozen benchmark
+    ``suite``: the first attempt whose arena can be built of ``case_config(cell, split,
+    index, attempt)``, seeded by :func:`~.grid.suite_case_seed` (suite, cell name, split,
+    index, attempt)."""
+    return first_placeable(lambda attempt: (case_config(cell, split, index, attempt),
+                                            suite_case_seed(suite, cell.name, split, index, attempt)),
+                           attempts, f"{suite}: {cell.name} case {index}")
+
+
+def suite_jobs(suite: str, sweep: str, split: str, per_cell: int, cells, case, pipeline: dict[str, Any]) -> list[Job]:
+    """The jobs of ``per_cell`` cases of every cell of a benchmark suite's ``split``, each
+    ``case(cell, split, index)`` -> (config tables, seed) mapped by ``pipeline``; jobs of
+    sweep ``{sweep}-{split}``, salted by suite, split and cell."""
+    out = []
+    for cell in cells:
+        for index in range(per_cell):
+            config, seed = case(cell, split, index)
+            config["map"] = {**SUITE_MAP, **pipeline}
+            out.append(Job(sweep=f"{sweep}-{split}", config_json=canonical_json(config), replicate=index,
+                           salt=f"{suite}/{split}/{cell.name}", case_seed=seed))
+    return out
 
 
 def stripped_log(log: EncounterLog) -> EncounterLog:

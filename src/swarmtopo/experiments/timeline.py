@@ -29,8 +29,8 @@ import numpy as np
 
 from ..arena import HOLE_SHAPES, OUTER_SHAPES
 from .accuracy import PIPELINES, Rate, failures_text, percent_text
-from .grid import Job, canonical_json, suite_case_seed
-from .sweep import first_placeable, run_cases
+from .grid import Job, suite_case_seed
+from .sweep import run_cases, suite_case, suite_jobs
 
 SUITE = "swarmtopo-timeline/1"
 KINDS = ("appear", "disappear", "door", "none")
@@ -65,14 +65,9 @@ class Cell:
 CELLS: tuple[Cell, ...] = tuple(Cell(kind, n) for kind in KINDS for n in AGENTS)
 
 
-def case_seed(cell: Cell, split: str, index: int, attempt: int = 0) -> int:
-    """64-bit seed of one case, from (SUITE, cell, split, index, attempt)."""
-    return suite_case_seed(SUITE, cell.name, split, index, attempt)
-
-
 def case_config(cell: Cell, split: str, index: int, attempt: int = 0) -> dict[str, Any]:
     """The ``[arena]`` and ``[swarm]`` tables of one case (module docstring)."""
-    rng = np.random.default_rng(case_seed(cell, split, index, attempt))
+    rng = np.random.default_rng(suite_case_seed(SUITE, cell.name, split, index, attempt))
     duration = float(np.round(rng.uniform(*DURATION_RANGE), 1))
     change_time = float(np.round(rng.uniform(*CHANGE_SHARE) * duration, 1))
     holes = int(rng.integers(0, 3))
@@ -89,22 +84,12 @@ def case_config(cell: Cell, split: str, index: int, attempt: int = 0) -> dict[st
 def case(cell: Cell, split: str, index: int) -> tuple[dict[str, Any], int]:
     """(config tables, case seed) of a case whose arena can be built (the next attempt's
     draw replaces one whose holes do not fit)."""
-    return first_placeable(lambda attempt: (case_config(cell, split, index, attempt),
-                                            case_seed(cell, split, index, attempt)),
-                           MAX_ATTEMPTS, f"{SUITE}: {cell.name} case {index}")
+    return suite_case(SUITE, cell, split, index, case_config, MAX_ATTEMPTS)
 
 
 def jobs(split: str, per_cell: int, cells=CELLS) -> list[Job]:
     """The default pipeline's jobs of ``per_cell`` cases of every cell of ``split``."""
-    out = []
-    for cell in cells:
-        for index in range(per_cell):
-            config, seed = case(cell, split, index)
-            config["map"] = {"subsample": "maxmin", "landmarks": "auto", "max_landmarks": 400, "maxdim": 1,
-                             **PIPELINES["default"]}
-            out.append(Job(sweep=f"timeline-{split}", config_json=canonical_json(config), replicate=index,
-                           salt=f"{SUITE}/{split}/{cell.name}", case_seed=seed))
-    return out
+    return suite_jobs(SUITE, "timeline", split, per_cell, cells, case, PIPELINES["default"])
 
 
 def true_changes(truth: list[dict[str, Any]]) -> list[dict[str, Any]]:

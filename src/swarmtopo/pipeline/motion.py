@@ -9,9 +9,11 @@ From the events alone (no speeds, no r_d, no model named), for the mapped log:
 * rho, the re-contact share: the share of events whose pair had an event less than
   ``RECONTACT_GAPS`` x g before.  A walker that keeps its heading (the cockroach,
   billiard, run-and-tumble, Lévy walks) rarely meets the same agent again so soon:
-  rho stays near 0.1 (at most 0.21 in the accuracy benchmark).  Where contacts *flicker* -- Brownian agents hovering about
-  r_d apart, flockmates travelling together -- one pair logs the start of contact
-  again and again, and rho reaches about 0.4-0.8.
+  rho is about 0.01-0.2 (at most 0.20 on the accuracy benchmark's cockroach logs).
+  Where contacts *flicker* -- Brownian agents hovering about r_d apart, flockmates
+  travelling together -- one pair logs the start of contact again and again: rho is
+  0.36-0.55 for the motion benchmark's Brownian logs and up to 0.55 for its flocks
+  (ordered flocks from 0.16: those are read as persistent).
 
 The regime is ``persistent`` when rho <= ``FLICKER_SHARE``, else ``flickering``.  A
 flickering log is mapped with every pair's events closer than ``RECONTACT_GAPS`` x g
@@ -19,7 +21,9 @@ to that pair's previous event merged into the first (one contact, however long i
 flickers): repeated starts of one contact carry no new place, but their tiny gaps
 set g, and with it the per-hop cost, the diffusion time and the windows, to the
 flicker's time scale instead of the swarm's.  A persistent log is mapped as it is,
-so every log the confidence was calibrated on maps exactly as before.
+so every log the confidence was calibrated on maps exactly as before.  A flickering
+log read by a shipped reader gets that reader's confidence recalibrated on flickering
+logs (:mod:`swarmtopo.readers.recalibrated`).
 
 Speed and persistence length are not identifiable from [t, a, b] alone: the rate
 of encounters is density x 2 r_d x the mean relative speed, and neither the density
@@ -41,8 +45,8 @@ RECONTACT_GAPS = 7.0
 event is a re-contact (and, in a flickering log, merged into it)."""
 FLICKER_SHARE = 0.3
 """Largest re-contact share rho of a ``persistent`` log.  The accuracy benchmark's
-cockroach logs have rho <= 0.21 (520 logs, ``lab/motion_regimes.py``; the highest in
-its two small rooms); Brownian and flocking logs about 0.4 and more."""
+cockroach logs have rho <= 0.20 (520 logs, ``lab/motion_regimes.py``; the highest in
+its two small rooms); its Brownian logs 0.36 and more (module docstring)."""
 
 
 @dataclass(frozen=True)
