@@ -28,6 +28,7 @@ import re
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
+from functools import partial
 from multiprocessing import get_context
 from pathlib import Path
 
@@ -37,6 +38,7 @@ from scipy.stats import binom
 from _measure import machine, revision
 from swarmtopo.experiments import accuracy as acc
 from swarmtopo.experiments.sweep import run_job
+from swarmtopo.experiments.store import decode_regions
 from swarmtopo.readers.registry import load_classifier
 
 DOC = Path(__file__).resolve().parent.parent / "docs" / "accuracy.md"
@@ -57,11 +59,15 @@ def recorded_slice(doc: Path = DOC) -> tuple[int, int]:
 def slice_records(workers: int) -> list[dict]:
     """The slice's outcome records (:func:`accuracy.outcomes`), its maps run on ``workers`` processes."""
     jobs = acc.reporting_jobs(per_cell=acc.SLICE_PER_CELL, pipelines={"default": acc.PIPELINES["default"]})
+    run = partial(run_job, keep="windows")  # each window's diagram, for the classifier to read
     if workers == 1:
-        rows = [run_job(job) for job in jobs]
+        rows = [run(job) for job in jobs]
     else:  # spawned, not forked: numba's threading layer is not fork-safe
         with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
-            rows = list(pool.map(run_job, jobs))
+            rows = list(pool.map(run, jobs))
+    for row in rows:  # a job's row holds its diagrams encoded, as the store keeps them
+        if row["diagrams"] is not None:
+            row["diagrams"] = decode_regions(row["diagrams"])
     return acc.outcomes(rows, load_classifier("default"))
 
 
