@@ -6,8 +6,9 @@
 Runs (resumably, windows' diagrams kept) the motion benchmark's *tuning* cases of the
 flickering models (Brownian and flocking swarms, 0-3 holes) twice: read as contact
 traces (the ``trace`` reader) and as log folders (the ``default`` reader).  On the maps
-the map reads as flickering it reads each region's windows again with the raw preset,
-fits (a, b) by logistic regression of "beta_1 right" on logit p, and prints the 5-fold
+the map reads as flickering and finds one region in (the map's confidence is then
+the region's, to which the recalibration applies) it reads the windows again with the
+raw preset, fits (a, b) by logistic regression of "beta_1 right" on logit p, and prints the 5-fold
 cross-validated Brier score against the raw confidence and a constant, and the wrong
 maps said at 0.9 or more.  ``--write`` writes swarmtopo/data/flicker-confidence.json.
 """
@@ -45,7 +46,8 @@ def raw_confidences(rows, preset: str) -> tuple[np.ndarray, np.ndarray]:
     reader = load_classifier(preset)
     p, right = [], []
     for row in rows:
-        if row["error"] is not None or (row["motion_estimate"] or {}).get("regime") != "flickering":
+        if (row["error"] is not None or (row["motion_estimate"] or {}).get("regime") != "flickering"
+                or len(row["diagrams"]) != 1):  # one region: the map's confidence is the region's, as it is applied
             continue
         readings = [reader.read([w["diagram"] for w in r["windows"]]) for r in row["diagrams"]]
         confidence = reader.map_confidence([r.confidence.get(1) for r in readings], 1)

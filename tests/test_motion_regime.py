@@ -16,7 +16,7 @@ from swarmtopo.io.logs import write_log
 from swarmtopo.log import EncounterLog
 from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.pipeline.config import ConfigError
-from swarmtopo.pipeline.motion import FLICKER_SHARE, estimate_motion, median_agent_gap, recontact_gaps
+from swarmtopo.pipeline.motion import MIN_AGENTS, estimate_motion, median_agent_gap, recontact_gaps
 from swarmtopo.sim.params import Billiard, Brownian, RunAndTumble
 from swarmtopo.viz.summary import map_json
 
@@ -31,7 +31,8 @@ def test_recontact_gaps_and_the_median_gap_of_a_hand_made_log():
     assert median_agent_gap(log) == 5.0
     estimate, mapped = estimate_motion(log, "merge")
     assert estimate.recontact_share == pytest.approx(0.5)  # 1 s and 9 s are within 7 x 5 s
-    assert estimate.regime == "flickering" and estimate.merged == 2
+    assert estimate.regime == "unread"  # 4 agents: too few to tell motion from re-meeting
+    assert estimate.merged == 2  # merging forced
     np.testing.assert_array_equal(mapped.t, [0.0, 1.5])
     assert estimate.partners_per_agent == pytest.approx(1.0) and estimate.encounter_rate == pytest.approx(0.2)
     kept = estimate_motion(log, "keep")[1]
@@ -54,7 +55,7 @@ def _random_meetings(n_agents, n_events, span, seed, burst=0):
 def test_flickering_contacts_are_merged_into_their_first_start_and_persistent_logs_are_kept():
     steady = _random_meetings(300, 6000, 40.0, 1)
     estimate, mapped = estimate_motion(steady)
-    assert estimate.regime == "persistent" and estimate.recontact_share < FLICKER_SHARE and mapped is steady
+    assert estimate.regime == "persistent" and estimate.recontact_share < 0.05 and mapped is steady
     flicker = _random_meetings(300, 6000, 40.0, 1, burst=3)
     estimate, mapped = estimate_motion(flicker)
     assert estimate.regime == "flickering" and estimate.recontact_share > 0.7
@@ -63,6 +64,25 @@ def test_flickering_contacts_are_merged_into_their_first_start_and_persistent_lo
     assert estimate.median_gap == pytest.approx(0.05)
     assert 18000 <= estimate.merged <= 18000 + 10 and set(mapped.t) <= set(flicker.t)
     assert mapped.n_events == flicker.n_events - estimate.merged
+
+
+def test_small_swarms_are_not_read_and_map_as_logged():
+    # 40 cockroaches over 200 s meet the same few again and again: rho is as high as a Brownian swarm's
+    log = st.simulate(st.default_arena(), 40, 200.0, rng=1).log
+    estimate, mapped = estimate_motion(log)
+    assert estimate.recontact_share > 0.25 and estimate.regime == "unread" and mapped is log
+    assert log.n_agents < MIN_AGENTS
+    tmap = map_encounters(log, MapConfig(**FAST))
+    assert tmap.n_events == log.n_events and not any("flicker" in w for w in tmap.warnings)
+
+
+def test_a_pair_met_just_before_the_window_keeps_its_first_contact_inside_it():
+    flicker = _random_meetings(300, 3000, 40.0, 4, burst=3)
+    t = np.r_[49.9, 50.0, flicker.t + 60.0]
+    log = EncounterLog.from_records(t, np.r_[0, 0, flicker.a], np.r_[1, 1, flicker.b])
+    estimate, merged = estimate_motion(log, window=(50.0, None))
+    assert estimate.regime == "flickering"
+    assert 50.0 in merged.t and 49.9 in merged.t  # outside the window nothing is merged
 
 
 def test_a_persistent_log_maps_exactly_as_without_the_estimate():
@@ -100,7 +120,7 @@ def test_the_estimate_reads_the_mapped_window_only():
 def test_recontacts_option_is_checked_and_the_paper_keeps_every_event(tmp_path, cli):
     with pytest.raises(ConfigError, match="recontacts"):
         MapConfig(recontacts="sometimes").validate()
-    sim = st.simulate(st.random_arena(1, rng=2), 100, 10.0, motion=Brownian(), rng=1)
+    sim = st.simulate(st.random_arena(1, rng=2), 200, 20.0, motion=Brownian(), rng=1)
     write_log(sim.log, tmp_path / "log")
     proc = cli("map", tmp_path / "log", "--out", tmp_path / "bad", "--recontacts", "often")
     assert proc.returncode == 2 and "recontacts" in proc.stderr and "Traceback" not in proc.stderr
@@ -190,3 +210,8 @@ def _unshipped(name):
     reader = st.load_classifier(name)
     reader.shipped_preset = None
     return reader
+
+
+def test_a_sweep_refuses_a_leader_for_another_motion_model():
+    with pytest.raises(SwarmtopoError, match="leader .* steers the cockroach model only"):
+        expand_grid({"swarm": {"motion": "brownian", "leash": 200.0}})

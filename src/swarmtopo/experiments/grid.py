@@ -574,6 +574,9 @@ def _canonical(point: dict, inputs: _InputFiles, fail):
         swarm["leash"] = point[("swarm", "leash")]
         swarm["leader_speed"] = point[("swarm", "leader_speed")]
     if point[("swarm", "motion")] != "cockroach":  # a cockroach job's config is as before walkers existed
+        if point[("swarm", "leash")] > 0:
+            fail(f"[swarm] motion = {_toml(point[('swarm', 'motion')])}", "a leader (leash > 0) steers the cockroach "
+                                                                          "model only")
         swarm["motion"] = point[("swarm", "motion")]
         fields = MOTION_MODELS[swarm["motion"]].__dataclass_fields__
         swarm.update({name: point[("swarm", name)] for name, field in MOTION_OPTIONS.items()

@@ -8,22 +8,25 @@ From the events alone (no speeds, no r_d, no model named), for the mapped log:
 * the partners per agent: distinct agents each agent met, on average;
 * rho, the re-contact share: the share of events whose pair had an event less than
   ``RECONTACT_GAPS`` x g before.  A walker that keeps its heading (the cockroach,
-  billiard, run-and-tumble, Lévy walks) rarely meets the same agent again so soon:
-  rho is about 0.01-0.2 (at most 0.20 on the accuracy benchmark's cockroach logs).
+  billiard, run-and-tumble, Lévy walks) seldom meets the same agent again so soon in a
+  swarm of a few hundred: rho is 0.02-0.20 on the accuracy benchmark's cockroach logs.
   Where contacts *flicker* -- Brownian agents hovering about r_d apart, flockmates
   travelling together -- one pair logs the start of contact again and again: rho is
-  0.36-0.55 for the motion benchmark's Brownian logs and up to 0.55 for its flocks
-  (ordered flocks from 0.16: those are read as persistent).
+  0.36-0.54 on the motion benchmark's Brownian logs and up to 0.53 on its flocks.
 
-The regime is ``persistent`` when rho <= ``FLICKER_SHARE``, else ``flickering``.  A
-flickering log is mapped with every pair's events closer than ``RECONTACT_GAPS`` x g
-to that pair's previous event merged into the first (one contact, however long it
-flickers): repeated starts of one contact carry no new place, but their tiny gaps
-set g, and with it the per-hop cost, the diffusion time and the windows, to the
-flicker's time scale instead of the swarm's.  A persistent log is mapped as it is,
-so every log the confidence was calibrated on maps exactly as before.  A flickering
-log read by a shipped reader gets that reader's confidence recalibrated on flickering
-logs (:mod:`swarmtopo.readers.recalibrated`).
+The regime is ``flickering`` when rho > ``FLICKER_SHARE``, else ``persistent``, and
+``unread`` for a swarm of fewer than ``MIN_AGENTS``: a few agents meet the same few
+again and again whatever their motion (cockroach swarms of 20-60 agents on 120-600 s
+logs have rho 0.25-0.45, as high as Brownian swarms; ``lab/motion_regimes.py``), so
+rho tells nothing there.  A flickering log is mapped with every pair's events closer
+than ``RECONTACT_GAPS`` x g to that pair's previous event (in the mapped window)
+merged into the first (one contact, however long it flickers): repeated starts of one
+contact carry no new place, but their tiny gaps set g, and with it the per-hop cost
+(unless meta.json gives r_d and v_c), the diffusion time and the windows, to the
+flicker's time scale instead of the swarm's.  A persistent or unread log is mapped as
+it is, so every log the confidence was calibrated on maps exactly as before.  A
+flickering log read by a shipped reader gets that reader's confidence recalibrated on
+flickering logs (:mod:`swarmtopo.readers.recalibrated`).
 
 Speed and persistence length are not identifiable from [t, a, b] alone: the rate
 of encounters is density x 2 r_d x the mean relative speed, and neither the density
@@ -44,9 +47,11 @@ RECONTACT_GAPS = 7.0
 """A pair's event closer than this many median agent gaps g to the pair's previous
 event is a re-contact (and, in a flickering log, merged into it)."""
 FLICKER_SHARE = 0.3
-"""Largest re-contact share rho of a ``persistent`` log.  The accuracy benchmark's
+"""Largest re-contact share rho of a ``persistent`` log: the accuracy benchmark's
 cockroach logs have rho <= 0.20 (520 logs, ``lab/motion_regimes.py``; the highest in
-its two small rooms); its Brownian logs 0.36 and more (module docstring)."""
+its two small rooms), its Brownian logs 0.36 and more (module docstring)."""
+MIN_AGENTS = 100
+"""Fewest agents whose log's regime is read (module docstring)."""
 
 
 @dataclass(frozen=True)
@@ -66,8 +71,10 @@ class MotionEstimate:
 
     def describe(self) -> str:
         """One line for the printed verdict and the report."""
-        what = ("contacts flicker (diffusive or flocking agents)" if self.regime == "flickering"
-                else "persistent walkers (like the cockroach, billiard, run-and-tumble or Lévy walks)")
+        what = {"flickering": "contacts flicker (diffusive or flocking agents)",
+                "persistent": "persistent walkers (like the cockroach, billiard, run-and-tumble or Lévy walks)",
+                "unread": f"not read (fewer than {MIN_AGENTS} agents meet the same few again whatever their motion)"
+                }[self.regime]
         text = (f"motion: {what}; re-contact share {self.recontact_share:.2f}, "
                 f"{self.encounter_rate:.2g} encounters per agent per s, {self.partners_per_agent:.0f} partners per agent")
         if self.merged:
@@ -88,15 +95,19 @@ def recontact_gaps(log: EncounterLog) -> np.ndarray:
 def estimate_motion(log: EncounterLog, recontacts: str = "auto",
                     window: tuple[float | None, float | None] | None = None) -> tuple[MotionEstimate, EncounterLog]:
     """The motion estimate of ``log``'s events in ``window`` (None: all) and the log to
-    map (re-contacts merged when ``recontacts`` is ``merge``, or ``auto`` and the log
-    flickers)."""
-    mapped = log if window is None else log.window(*window)
+    map (re-contacts inside the window merged when ``recontacts`` is ``merge``, or
+    ``auto`` and the log flickers)."""
+    inside = np.ones(log.n_events, bool) if window is None else _in_window(log, window)
+    mapped = replace(log, t=log.t[inside], a=log.a[inside], b=log.b[inside])
     gap = median_agent_gap(mapped)
-    since = recontact_gaps(log)
-    recontact = since < RECONTACT_GAPS * gap if gap is not None else np.zeros(log.n_events, bool)
-    inside = np.ones(log.n_events, bool) if window is None else np.isin(np.arange(log.n_events), _in_window(log, window))
+    recontact = np.zeros(log.n_events, bool)
+    if gap is not None:
+        recontact[inside] = recontact_gaps(mapped) < RECONTACT_GAPS * gap
     share = float(recontact[inside].mean()) if inside.any() else 0.0
-    regime = "flickering" if share > FLICKER_SHARE else "persistent"
+    if log.n_agents < MIN_AGENTS:
+        regime = "unread"
+    else:
+        regime = "flickering" if share > FLICKER_SHARE else "persistent"
     merge = recontacts == "merge" or (recontacts == "auto" and regime == "flickering")
     span = float(mapped.t.max() - mapped.t.min()) if mapped.n_events else 0.0
     pairs = np.unique(np.stack([np.minimum(mapped.a, mapped.b), np.maximum(mapped.a, mapped.b)]), axis=1)
@@ -108,7 +119,7 @@ def estimate_motion(log: EncounterLog, recontacts: str = "auto",
     return MotionEstimate(regime=regime, recontact_share=share, median_gap=gap,
                           encounter_rate=2 * mapped.n_events / (n * span) if span > 0 else 0.0,
                           partners_per_agent=2 * pairs.shape[1] / n,
-                          merged=int((recontact & inside).sum()) if merged is not log else 0), merged
+                          merged=int(recontact.sum()) if merged is not log else 0), merged
 
 
 def median_agent_gap(log: EncounterLog) -> float | None:
@@ -120,7 +131,7 @@ def median_agent_gap(log: EncounterLog) -> float | None:
 
 def _in_window(log: EncounterLog, window) -> np.ndarray:
     lo, hi = (-np.inf if window[0] is None else window[0]), (np.inf if window[1] is None else window[1])
-    return np.flatnonzero((log.t >= lo) & (log.t <= hi))
+    return (log.t >= lo) & (log.t <= hi)
 
 
 def motion_warnings(motion: MotionEstimate, recalibrated: bool) -> list[str]:
@@ -137,4 +148,4 @@ def motion_warnings(motion: MotionEstimate, recalibrated: bool) -> list[str]:
              "the confidence was calibrated on persistent walkers only")
     return [f"the agents' contacts flicker ({100 * motion.recontact_share:.0f} % of the encounters repeat a pair's "
             f"contact within {RECONTACT_GAPS:g} median gaps; persistent walkers stay under {100 * FLICKER_SHARE:.0f} "
-            f"%): diffusive or flocking agents; {done}, and {trust} (docs/model.md, 'Motion read from the log')"]
+            f"% in swarms of a few hundred): diffusive or flocking agents; {done}, and {trust} (docs/model.md, 'Motion read from the log')"]
