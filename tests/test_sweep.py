@@ -437,8 +437,11 @@ def _group_gone(pgid: int, timeout: float) -> bool:
 @pytest.mark.slow
 def test_ctrl_c_stops_the_local_cluster_and_a_rerun_finishes_exactly_the_rest(tmp_path, sweep_file, reference,
                                                                               dask_cluster):
-    store = tmp_path / "s.duckdb"
-    proc, stderr = _interrupt_after_first_row(sweep_file, store, signal.SIGINT, "--workers", "1")
+    for attempt in range(3):  # on a loaded machine the sweep may finish before the first row is seen: again
+        store = tmp_path / f"s{attempt}.duckdb"
+        proc, stderr = _interrupt_after_first_row(sweep_file, store, signal.SIGINT, "--workers", "1")
+        if proc.returncode != 0:
+            break
     try:
         assert proc.returncode == 130 and "Traceback" not in stderr, stderr
         assert stderr.strip().endswith("run the same command again to run the rest")
