@@ -67,6 +67,10 @@ VERBOSE_HELP = "Also report each stage's details and timings on stderr (in pipes
 
 
 OVERWRITE_HELP = "Replace the log already in --out (its log files are replaced or removed; other files stay)."
+DASK_SCHEDULER_OPTION = typer.Option(None, "--scheduler", help="Address of an existing Dask scheduler.")
+LOCAL_WORKERS_OPTION = typer.Option(None, "--workers", min=1,
+                                    help="Worker processes of the local cluster (default: all cores).")
+"""The ``--scheduler`` and ``--workers`` options of ``sweep`` and every ``bench`` command."""
 
 
 @contextmanager
@@ -608,8 +612,7 @@ def sweep(
     store: Path = typer.Option(..., "--store", help="DuckDB result store (created; one row per job in table jobs)."),
     scheduler: Optional[str] = typer.Option(None, "--scheduler",
                                             help="Address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786."),
-    workers: Optional[int] = typer.Option(None, "--workers", min=1,
-                                          help="Worker processes of the local cluster (default: all cores)."),
+    workers: Optional[int] = LOCAL_WORKERS_OPTION,
     job_timeout: Optional[float] = typer.Option(None, "--job-timeout", min=0.001,
                                                 help="Seconds a job may run before it is killed and stored as a "
                                                      "timeout row (default: [sweep] job_timeout, else 3600)."),
@@ -791,9 +794,8 @@ def bench_accuracy(
     quick: bool = typer.Option(False, "--quick", help="10 reporting cases per cell instead of 30, no planning grid (minutes, not an hour)."),
     store: Path = typer.Option(Path("accuracy.duckdb"), "--store", help="DuckDB result store (resumable)."),
     out_dir: Path = typer.Option(Path("accuracy"), "--out", help="Folder for accuracy.md, accuracy.json, plan.json."),
-    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Address of an existing Dask scheduler."),
-    workers: Optional[int] = typer.Option(None, "--workers", min=1,
-                                          help="Worker processes of the local cluster (default: all cores)."),
+    scheduler: Optional[str] = DASK_SCHEDULER_OPTION,
+    workers: Optional[int] = LOCAL_WORKERS_OPTION,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
@@ -870,9 +872,8 @@ def bench_exploration(
     quick: bool = typer.Option(False, "--quick", help="2 cases per cell instead of 12."),
     store: Path = typer.Option(Path("exploration.duckdb"), "--store", help="DuckDB result store (resumable)."),
     out_dir: Path = typer.Option(Path("exploration"), "--out", help="Folder for exploration.md and exploration.json."),
-    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Address of an existing Dask scheduler."),
-    workers: Optional[int] = typer.Option(None, "--workers", min=1,
-                                          help="Worker processes of the local cluster (default: all cores)."),
+    scheduler: Optional[str] = DASK_SCHEDULER_OPTION,
+    workers: Optional[int] = LOCAL_WORKERS_OPTION,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
@@ -897,9 +898,8 @@ def bench_motion(
     split: str = typer.Option("reporting", "--split", help="reporting, or tuning (cases of their own seeds)."),
     store: Path = typer.Option(Path("motion.duckdb"), "--store", help="DuckDB result store (resumable)."),
     out_dir: Path = typer.Option(Path("motion"), "--out", help="Folder for motion.md and motion.json."),
-    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Address of an existing Dask scheduler."),
-    workers: Optional[int] = typer.Option(None, "--workers", min=1,
-                                          help="Worker processes of the local cluster (default: all cores)."),
+    scheduler: Optional[str] = DASK_SCHEDULER_OPTION,
+    workers: Optional[int] = LOCAL_WORKERS_OPTION,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
@@ -926,9 +926,8 @@ def bench_timeline(
     quick: bool = typer.Option(False, "--quick", help="5 cases per cell instead of 20."),
     store: Path = typer.Option(Path("timeline.duckdb"), "--store", help="DuckDB result store (resumable)."),
     out_dir: Path = typer.Option(Path("timeline"), "--out", help="Folder for timeline.md and timeline.json."),
-    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Address of an existing Dask scheduler."),
-    workers: Optional[int] = typer.Option(None, "--workers", min=1,
-                                          help="Worker processes of the local cluster (default: all cores)."),
+    scheduler: Optional[str] = DASK_SCHEDULER_OPTION,
+    workers: Optional[int] = LOCAL_WORKERS_OPTION,
     quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:

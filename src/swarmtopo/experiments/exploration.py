@@ -27,7 +27,7 @@ from ..arena import HALL_SHAPES
 from ..beacon import LEADER_SETTLE, LEADER_SPEED
 from .accuracy import PIPELINES, Rate, failures_text, percent_text
 from .grid import Job, suite_case_seed
-from .sweep import run_cases, suite_case, suite_jobs
+from .sweep import run_suite, suite_case, suite_jobs
 
 SUITE = "swarmtopo-exploration/1"
 HOLES = (1, 2, 3, 4)
@@ -126,12 +126,8 @@ def run_benchmark(store, *, quick: bool = False, split: str = "reporting", per_c
                   keep: str = "map") -> dict[str, Any]:
     """Run (or resume) the cases of ``split``; the summary document (records and :func:`table`)."""
     per_cell = per_cell or (QUICK_PER_CELL if quick else REPORTING_PER_CELL)
-    summary, rows = run_cases(jobs(split, per_cell, cells), store, scheduler=scheduler, workers=workers,
-                              progress=progress, keep=keep)
-    recs = records(rows)
-    return {"suite": SUITE, "split": split, "cases_per_cell": per_cell, "leader_speed": LEADER_SPEED,
-            "seconds": summary.seconds, "jobs_run": summary.run, "workers": summary.workers,
-            "table": table(recs), "records": recs}
+    return run_suite(SUITE, split, per_cell, jobs(split, per_cell, cells), store, records, table,
+                     {"leader_speed": LEADER_SPEED}, scheduler=scheduler, workers=workers, progress=progress, keep=keep)
 
 
 def markdown(summary: dict[str, Any], command: str) -> str:

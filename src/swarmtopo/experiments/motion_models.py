@@ -25,7 +25,7 @@ import numpy as np
 from ..arena import HOLE_SHAPES, OUTER_SHAPES
 from .accuracy import HELD_OUT_FAMILY, SCALE_RANGE, TRACE_PIPELINE, Rate, brier_gain, failures_text, percent_text
 from .grid import Job, suite_case_seed
-from .sweep import run_cases, suite_case, suite_jobs
+from .sweep import run_suite, suite_case, suite_jobs
 
 SUITE = "swarmtopo-motion/1"
 MODELS = ("cockroach", "billiard", "run-and-tumble", "brownian", "levy", "flocking")
@@ -137,12 +137,8 @@ def run_benchmark(store, *, quick: bool = False, split: str = "reporting", per_c
                   keep: str = "map") -> dict[str, Any]:
     """Run (or resume) the cases of ``split``; the summary document (records and :func:`table`)."""
     per_cell = per_cell or (QUICK_PER_CELL if quick else REPORTING_PER_CELL)
-    summary, rows = run_cases(jobs(split, per_cell, cells), store, scheduler=scheduler, workers=workers,
-                              progress=progress, keep=keep)
-    recs = records(rows)
-    return {"suite": SUITE, "split": split, "cases_per_cell": per_cell, "budget": list(BUDGET),
-            "seconds": summary.seconds, "jobs_run": summary.run, "workers": summary.workers,
-            "table": table(recs), "records": recs}
+    return run_suite(SUITE, split, per_cell, jobs(split, per_cell, cells), store, records, table,
+                     {"budget": list(BUDGET)}, scheduler=scheduler, workers=workers, progress=progress, keep=keep)
 
 
 def markdown(summary: dict[str, Any], command: str) -> str:

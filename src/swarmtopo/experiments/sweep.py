@@ -395,13 +395,18 @@ TOUCH_SECONDS = 30.0
 """How often a run notes in the store that it is alive (``swarmtopo status``)."""
 
 
-def run_cases(todo: list[Job], store, *, scheduler=None, workers=None, progress=None, keep: str = "map"):
-    """Run (or resume) a benchmark's jobs ``todo``: (the :func:`run_sweep` summary, their rows
-    sorted by key)."""
+def run_suite(suite: str, split: str, per_cell: int, todo: list[Job], store, records, table,
+              extra: dict[str, Any], *, scheduler=None, workers=None, progress=None, keep: str = "map"
+              ) -> dict[str, Any]:
+    """Run (or resume) a benchmark suite's jobs ``todo`` and its summary document: the
+    suite, split, cases per cell, ``extra`` (the suite's own settings), the run's seconds,
+    jobs and workers, ``table(records(rows))`` and the records (rows sorted by key)."""
     from .store import iter_jobs
 
     summary = run_sweep(todo, store, scheduler=scheduler, workers=workers, progress=progress, keep=keep)
-    return summary, sorted(iter_jobs(store, keys=[job.key for job in todo]), key=lambda row: row["key"])
+    recs = records(sorted(iter_jobs(store, keys=[job.key for job in todo]), key=lambda row: row["key"]))
+    return {"suite": suite, "split": split, "cases_per_cell": per_cell, **extra, "seconds": summary.seconds,
+            "jobs_run": summary.run, "workers": summary.workers, "table": table(recs), "records": recs}
 
 
 def run_sweep(

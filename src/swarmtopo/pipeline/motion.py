@@ -41,7 +41,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..log import EncounterLog
-from ..metric.graph import agent_gaps
+from ..metric.graph import agent_gaps, event_slice
 
 RECONTACT_GAPS = 7.0
 """A pair's event closer than this many median agent gaps g to the pair's previous
@@ -97,29 +97,27 @@ def estimate_motion(log: EncounterLog, recontacts: str = "auto",
     """The motion estimate of ``log``'s events in ``window`` (None: all) and the log to
     map (re-contacts inside the window merged when ``recontacts`` is ``merge``, or
     ``auto`` and the log flickers)."""
-    inside = np.ones(log.n_events, bool) if window is None else _in_window(log, window)
+    inside = slice(0, log.n_events) if window is None else slice(*event_slice(log, window))
     mapped = replace(log, t=log.t[inside], a=log.a[inside], b=log.b[inside])
     gap = median_agent_gap(mapped)
     recontact = np.zeros(log.n_events, bool)
     if gap is not None:
         recontact[inside] = recontact_gaps(mapped) < RECONTACT_GAPS * gap
-    share = float(recontact[inside].mean()) if inside.any() else 0.0
+    share = float(recontact[inside].mean()) if mapped.n_events else 0.0
     if log.n_agents < MIN_AGENTS:
         regime = "unread"
     else:
         regime = "flickering" if share > FLICKER_SHARE else "persistent"
     merge = recontacts == "merge" or (recontacts == "auto" and regime == "flickering")
+    merged = int(recontact.sum()) if merge else 0
     span = float(mapped.t.max() - mapped.t.min()) if mapped.n_events else 0.0
     pairs = np.unique(np.stack([np.minimum(mapped.a, mapped.b), np.maximum(mapped.a, mapped.b)]), axis=1)
     n = max(log.n_agents, 1)
-    merged = log
-    if merge and recontact.any():
-        keep = ~recontact
-        merged = replace(log, t=log.t[keep], a=log.a[keep], b=log.b[keep])
-    return MotionEstimate(regime=regime, recontact_share=share, median_gap=gap,
-                          encounter_rate=2 * mapped.n_events / (n * span) if span > 0 else 0.0,
-                          partners_per_agent=2 * pairs.shape[1] / n,
-                          merged=int(recontact.sum()) if merged is not log else 0), merged
+    estimate = MotionEstimate(regime=regime, recontact_share=share, median_gap=gap,
+                              encounter_rate=2 * mapped.n_events / (n * span) if span > 0 else 0.0,
+                              partners_per_agent=2 * pairs.shape[1] / n, merged=merged)
+    keep = ~recontact
+    return estimate, (replace(log, t=log.t[keep], a=log.a[keep], b=log.b[keep]) if merged else log)
 
 
 def median_agent_gap(log: EncounterLog) -> float | None:
@@ -127,11 +125,6 @@ def median_agent_gap(log: EncounterLog) -> float | None:
     gaps = agent_gaps(log)
     gaps = gaps[gaps > 0]
     return float(np.median(gaps)) if len(gaps) else None
-
-
-def _in_window(log: EncounterLog, window) -> np.ndarray:
-    lo, hi = (-np.inf if window[0] is None else window[0]), (np.inf if window[1] is None else window[1])
-    return (log.t >= lo) & (log.t <= hi)
 
 
 def motion_warnings(motion: MotionEstimate, recalibrated: bool) -> list[str]:
@@ -148,4 +141,5 @@ def motion_warnings(motion: MotionEstimate, recalibrated: bool) -> list[str]:
              "the confidence was calibrated on persistent walkers only")
     return [f"the agents' contacts flicker ({100 * motion.recontact_share:.0f} % of the encounters repeat a pair's "
             f"contact within {RECONTACT_GAPS:g} median gaps; persistent walkers stay under {100 * FLICKER_SHARE:.0f} "
-            f"% in swarms of a few hundred): diffusive or flocking agents; {done}, and {trust} (docs/model.md, 'Motion read from the log')"]
+            f"% in swarms of a few hundred): diffusive or flocking agents; {done}, and {trust} "
+            "(docs/model.md, 'Motion read from the log')"]

@@ -136,6 +136,10 @@ class WindowReader:
     ``pooled_betti(windows)``, ``margin(diagram, n)``, ``region_confidence(windows, voted)``,
     ``length_thresholds(diagram)``, ``provenance_``, ``to_json`` and ``from_json`` (module docstring)."""
 
+    shipped_preset: str | None = None
+    """The preset name when :func:`~swarmtopo.readers.registry.load_classifier` loaded a
+    shipped reader (what :mod:`~swarmtopo.readers.recalibrated`'s fits are for)."""
+
     def save(self, path) -> None:
         """Write the fitted reader as JSON (its ``to_json``), atomically."""
         write_json(self.to_json(), path)

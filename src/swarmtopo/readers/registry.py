@@ -60,7 +60,8 @@ def load_classifier(name: str | Path) -> BettiReader:
         source, obj = str(path), read_json(path)
     check_format(obj, tuple(READERS), "swarmtopo classifier", source)
     reader = READERS[obj["format"]].from_json(obj, source=source)
-    reader.shipped_preset = str(name) if str(name) in PRESETS else None  # what readers.recalibrated fits are for
+    if str(name) in PRESETS:
+        reader.shipped_preset = str(name)
     return reader
 
 

@@ -44,6 +44,14 @@ MIN_WALL_OFFSET_FRACTION = 0.1
 """Wall-follow offset lower bound, as a fraction of r_d (see module docstring)."""
 
 
+def _positive_fields(params, *names: str, allow_inf: bool = False) -> None:
+    """Check (and store as float) each named field of a frozen parameter dataclass: a
+    positive number, named ``Class.field`` in the error."""
+    for name in names:
+        value = positive(f"{type(params).__name__}.{name}", getattr(params, name), allow_inf=allow_inf)
+        object.__setattr__(params, name, value)
+
+
 @dataclass(frozen=True)
 class MotionParams:
     """Bio-inspired mobility model (paper, "Bio-Inspired Mobility Model").
@@ -77,10 +85,8 @@ class MotionParams:
     tau_exit: float = 10.0
 
     def __post_init__(self):
-        for name in ("v_c", "l_star", "v_p", "tau_s", "tau_l"):
-            object.__setattr__(self, name, positive(f"MotionParams.{name}", getattr(self, name)))
-        for name in ("tau_stop", "tau_exit"):
-            object.__setattr__(self, name, positive(f"MotionParams.{name}", getattr(self, name), allow_inf=True))
+        _positive_fields(self, "v_c", "l_star", "v_p", "tau_s", "tau_l")
+        _positive_fields(self, "tau_stop", "tau_exit", allow_inf=True)
         object.__setattr__(self, "p_sh", fraction("MotionParams.p_sh", self.p_sh))
 
 
@@ -179,7 +185,7 @@ class Billiard:
     name = "billiard"
 
     def __post_init__(self):
-        object.__setattr__(self, "speed", positive("Billiard.speed", self.speed))
+        _positive_fields(self, "speed")
 
 
 @dataclass(frozen=True)
@@ -203,8 +209,7 @@ class RunAndTumble:
     name = "run-and-tumble"
 
     def __post_init__(self):
-        object.__setattr__(self, "speed", positive("RunAndTumble.speed", self.speed))
-        object.__setattr__(self, "tumble_rate", positive("RunAndTumble.tumble_rate", self.tumble_rate))
+        _positive_fields(self, "speed", "tumble_rate")
 
 
 @dataclass(frozen=True)
@@ -226,7 +231,7 @@ class Brownian:
     name = "brownian"
 
     def __post_init__(self):
-        object.__setattr__(self, "diffusion", positive("Brownian.diffusion", self.diffusion))
+        _positive_fields(self, "diffusion")
 
 
 @dataclass(frozen=True)
@@ -254,12 +259,9 @@ class LevyWalk:
     name = "levy"
 
     def __post_init__(self):
-        object.__setattr__(self, "speed", positive("LevyWalk.speed", self.speed))
-        object.__setattr__(self, "min_step", positive("LevyWalk.min_step", self.min_step))
-        mu = positive("LevyWalk.exponent", self.exponent)
-        if not 1.0 < mu <= 3.0:
+        _positive_fields(self, "speed", "min_step", "exponent")
+        if not 1.0 < self.exponent <= 3.0:
             raise InputError("LevyWalk.exponent must be in (1, 3]", value=self.exponent)
-        object.__setattr__(self, "exponent", mu)
 
 
 @dataclass(frozen=True)
@@ -288,8 +290,7 @@ class Flocking:
     name = "flocking"
 
     def __post_init__(self):
-        object.__setattr__(self, "speed", positive("Flocking.speed", self.speed))
-        object.__setattr__(self, "radius", positive("Flocking.radius", self.radius))
+        _positive_fields(self, "speed", "radius")
         eta = non_negative("Flocking.noise", self.noise)
         if eta > 2 * math.pi:
             raise InputError("Flocking.noise must be in [0, 2 pi] rad", value=self.noise)

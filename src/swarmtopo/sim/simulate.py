@@ -399,11 +399,11 @@ def _meta(arena, n, n_steps, dt, motion, sensing, commands, static_fraction, sta
         "static_time": float(static_time),
         "arena_betti": list(arena.betti),
     }
-    speeds = {"v_c": motion.v_c, "v_p": motion.v_p} if isinstance(motion, MotionParams) else {}
-    if not isinstance(motion, MotionParams):  # a cockroach log has no model name (as before walkers existed)
+    if isinstance(motion, MotionParams):  # a cockroach log has no model name (as before walkers existed)
+        speeds = {"v_c": motion.v_c, "v_p": motion.v_p}
+    else:
         provenance["motion_model"] = motion_name(motion)
-        if hasattr(motion, "speed"):
-            speeds = {"v_c": motion.speed, "v_p": motion.speed}
+        speeds = {"v_c": motion.speed, "v_p": motion.speed} if hasattr(motion, "speed") else {}
     return jsonable({
         "format": LOG_FORMAT,
         "version": __version__,
