@@ -353,7 +353,7 @@ def test_simulate_warns_of_passages_narrower_than_r_d(tmp_path):
         "apart, and the map may miss that hole")
 
 
-@pytest.mark.parametrize("command", ["simulate", "ingest", "map", "demo", "sweep", "reproduce"])
+@pytest.mark.parametrize("command", ["simulate", "perturb", "ingest", "map", "demo", "sweep", "reproduce"])
 def test_help_shows_an_example(command):
     proc = run(command, "--help")
     assert proc.returncode == 0 and "Example: swarmtopo" in proc.stdout
@@ -454,8 +454,8 @@ def test_version():
     assert proc.returncode == 0 and proc.stdout == f"swarmtopo {version('swarmtopo')}\n" and proc.stderr == ""
 
 
-@pytest.mark.parametrize("command", [(), ("simulate",), ("ingest",), ("map",), ("demo",), ("sweep",), ("reproduce",),
-                                     ("plan",), ("bench",), ("bench", "accuracy")])
+@pytest.mark.parametrize("command", [(), ("simulate",), ("perturb",), ("ingest",), ("map",), ("demo",), ("sweep",),
+                                     ("reproduce",), ("plan",), ("bench",), ("bench", "accuracy"), ("bench", "faults")])
 def test_help_sends_nobody_to_files_they_do_not_have(command):
     """A pip install has no docs/ folder: a pointer to one says it is in the source repository."""
     import re

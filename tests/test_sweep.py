@@ -146,9 +146,9 @@ def test_key_and_seed_are_the_hash_of_config_replicate_and_salt():
     digest = hashlib.sha256(text.encode()).hexdigest()
     assert job.key == digest
     assert job.seed == int(digest[:16], 16)
-    children = np.random.SeedSequence(job.seed).spawn(3)
+    children = np.random.SeedSequence(job.seed).spawn(4)
     assert job.stream_seeds() == {name: int(c.generate_state(1, np.uint64)[0])
-                                  for name, c in zip(("arena", "simulation", "map"), children)}
+                                  for name, c in zip(("arena", "simulation", "map", "faults"), children)}
 
 
 def test_growing_the_grid_keeps_every_finished_job():
@@ -230,7 +230,7 @@ def test_keys_are_the_same_in_another_process():
     ("[sweep]\nseed = 3", ["[sweep] seed: unknown key"]),
     ("map = 3", ["[map]: expected a table"]),
     ("[map\nmetric = 1", ["invalid TOML", "line 1"]),
-    *((body, ["no key in [arena], [swarm] or [map]: nothing to sweep"])
+    *((body, ["no key in [arena], [swarm], [map] or [faults]: nothing to sweep"])
       for body in ("", "# a comment", "[sweep]\nreplicates = 3\n[swarm]\n[map]")),
 ])
 def test_malformed_file_is_one_error_naming_file_key_and_value(tmp_path, body, fragments):

@@ -14,6 +14,7 @@ The public names (loaded on first use, so ``import swarmtopo`` stays light):
 
 ``simulate``         run the bio-inspired swarm in an arena -> ``Simulation`` (``.log``)
 ``MotionParams``     the cockroach's motion; ``Billiard``, ``RunAndTumble``, ``Brownian``, ``LevyWalk``, ``Flocking`` others
+``perturb``          a log through a faulty radio (``Faults``: lost, false, late, duplicated reports, dying agents)
 ``read_log``         a log folder (events.csv|parquet, status, meta.json) -> ``EncounterLog``
 ``read_trace``       a proximity trace (CSV/Parquet, SocioPatterns, ONE) -> ``(EncounterLog, report)``
 ``map_encounters``   ``EncounterLog`` -> ``TopologicalMap`` (Betti numbers, confidence, diagrams)
@@ -45,6 +46,8 @@ _PUBLIC = {
     "Brownian": "swarmtopo.sim",
     "LevyWalk": "swarmtopo.sim",
     "Flocking": "swarmtopo.sim",
+    "Faults": "swarmtopo.sim",
+    "perturb": "swarmtopo.sim",
     "read_log": "swarmtopo.io",
     "read_trace": "swarmtopo.io",
     "read_arena": "swarmtopo.io",

@@ -180,6 +180,31 @@ def _progress(description: str, quiet: bool):
         yield lambda fraction: bar.update(task, completed=fraction)
 
 
+FAULT_OPTIONS = {
+    "lost": typer.Option(0.0, "--lost", min=0.0, max=1.0, help="Faults: share of reports lost independently."),
+    "burst_lost": typer.Option(0.0, "--burst-lost", min=0.0, max=1.0,
+                               help="Faults: share of each agent's time its radio is down (its reports lost)."),
+    "burst_length": typer.Option(2.0, "--burst-length", min=0.0, callback=_finite_option,
+                                 help="Faults: mean length (s) of a radio outage of --burst-lost."),
+    "false_encounters": typer.Option(0.0, "--false-encounters", min=0.0, max=1.0,
+                                     help="Faults: false reports of pairs that never met, per report."),
+    "jitter": typer.Option(0.0, "--jitter", min=0.0, callback=_finite_option,
+                           help="Faults: standard deviation (s) of the noise on each report's time."),
+    "clock_offset": typer.Option(0.0, "--clock-offset", min=0.0, callback=_finite_option,
+                                 help="Faults: each agent's clock is off by up to this many seconds (uniform)."),
+    "clock_drift": typer.Option(0.0, "--clock-drift", min=0.0, max=0.999,
+                                help="Faults: each agent's clock drifts by up to this many s per s (uniform)."),
+    "dying": typer.Option(0.0, "--dying", min=0.0, max=1.0,
+                          help="Faults: share of agents whose battery dies at a random time."),
+    "duplicated": typer.Option(0.0, "--duplicated", min=0.0, max=1.0,
+                               help="Faults: share of reports delivered twice (by the pair's other agent)."),
+    "duplicate_delay": typer.Option(0.5, "--duplicate-delay", min=0.0, callback=_finite_option,
+                                    help="Faults: a duplicate arrives up to this many seconds later (uniform)."),
+}
+"""The fault options of ``perturb`` and ``simulate`` (:class:`~swarmtopo.sim.faults.Faults`;
+docs/model.md, 'Faulty sensing')."""
+
+
 @app.command(epilog="Example: swarmtopo simulate --holes 2 --agents 200 --duration 30 --seed 1 --out runs/two-holes --truth")
 def simulate(
     out_dir: Path = typer.Option(..., "--out", help="Folder to write the log into (created)."),
@@ -230,18 +255,30 @@ def simulate(
                                                  help="Flocking: alignment radius in mm (default 30)."),
     noise: Optional[float] = typer.Option(None, "--noise", callback=_finite_option,
                                           help="Flocking: heading noise eta in [0, 2 pi] rad (default 1)."),
+    lost: float = FAULT_OPTIONS["lost"],
+    burst_lost: float = FAULT_OPTIONS["burst_lost"],
+    burst_length: float = FAULT_OPTIONS["burst_length"],
+    false_encounters: float = FAULT_OPTIONS["false_encounters"],
+    jitter: float = FAULT_OPTIONS["jitter"],
+    clock_offset: float = FAULT_OPTIONS["clock_offset"],
+    clock_drift: float = FAULT_OPTIONS["clock_drift"],
+    dying: float = FAULT_OPTIONS["dying"],
+    duplicated: float = FAULT_OPTIONS["duplicated"],
+    duplicate_delay: float = FAULT_OPTIONS["duplicate_delay"],
     overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar, no summary."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
 ) -> None:
     """Simulate a swarm in an arena and write its encounter log folder."""
     import time
+    from dataclasses import replace
 
     from .arena import random_arena
     from .changing import ChangingArena, true_betti_text
     from .io.arenas import read_arena
     from .io.logs import write_log
     from .sim import SensingParams, check_run_size, check_static_time, check_time_step, simulate as run
+    from .sim.faults import perturb
     from .sim.params import make_motion
     from .sim.simulate import check_duration
 
@@ -264,6 +301,10 @@ def simulate(
     if leader_speed is not None and beacon != "sweep":
         raise typer.BadParameter("sets the speed of --beacon sweep only (a path file gives its own speed)",
                                  param_hint="--leader-speed")
+    faults = _check_option("--lost ... --duplicate-delay", _faults, locals())
+    if faults.any and truth:
+        raise typer.BadParameter("truth.csv gives the true positions of each true event, and a log with faults has "
+                                 "other events: drop --truth (arena.geojson is written anyway)", param_hint="--truth")
 
     if arena:  # scaled like a sweep's file arena
         world = read_arena(arena) if scale == 1.0 else read_arena(arena).scaled(scale)
@@ -284,6 +325,9 @@ def simulate(
             sim = run(world, agents, duration, dt=dt, motion=walk, sensing=SensingParams(r_d=rd), rng=seed,
                       static_fraction=static_fraction, static_time=static_time, truth=truth,
                       trajectory_every=trajectories, progress=tick, **leader)
+        if faults.any:  # the faults draw from a stream of their own, spawned from the seed
+            fault_seed = int(np.random.SeedSequence(seed).spawn(2)[1].generate_state(1)[0])
+            sim = replace(sim, log=perturb(sim.log, faults, fault_seed)[0])
         if verbose:
             _detail(f"simulated in {time.perf_counter() - start:.2f} s: {sim.log.n_events} encounters, "
                     f"{len(sim.log.status_t)} status changes")
@@ -296,6 +340,8 @@ def simulate(
                  if isinstance(world, ChangingArena) else f"in an arena with {b0} region(s) and {b1} hole(s)")
         out.print(f"{sim.log.n_events} encounters of {agents} agents over {sim.log.meta['duration']:g} s {where}",
                   markup=False, highlight=False, soft_wrap=True)
+        if faults.any:
+            out.print(_fault_counts(sim.log.meta["faults"][-1]), markup=False, highlight=False, soft_wrap=True)
         for moved in sim.log.meta["simulation"].get("relocated", []):
             if moved["agents"]:
                 out.print(f"at t = {moved['t']:g} s the arena changed: {moved['agents']} agent(s) stood where an "
@@ -309,6 +355,26 @@ def simulate(
         out.print(f"wrote {', '.join(str(p) for p in written)}", markup=False, highlight=False, soft_wrap=True)
 
 
+def _faults(given: dict):
+    """The :class:`~swarmtopo.sim.faults.Faults` of a command's fault options (``given``: its locals)."""
+    from .sim.faults import Faults
+
+    return Faults(**{name: given[name] for name in FAULT_OPTIONS})
+
+
+def _fault_counts(record: dict) -> str:
+    """One line of what :func:`~swarmtopo.sim.faults.perturb` did (its record)."""
+    c = record["counts"]
+    parts = [f"{c['reports']} reports: {c['delivered']} delivered"]
+    for key, text in (("after_death", "lost to {} dead agents' batteries"), ("lost", "lost"),
+                      ("lost_in_outages", "lost in radio outages"), ("duplicated", "duplicated"),
+                      ("false", "false encounters added")):
+        if c[key]:
+            parts.append(f"{c[key]} " + text.format(c["died"]))
+    shift = f"; times shifted by {record['shift']:.3g} s (a clock before 0 s)" if record["shift"] else ""
+    return "faults: " + ", ".join(parts) + shift
+
+
 def _leader_track(beacon: str, world, leash: float, speed: float, duration: float, quiet: bool):
     """The leader's track of ``simulate --beacon``: a file's, or ``sweep`` along the arena's long axis."""
     from .beacon import LEADER_SPEED, long_axis_track
@@ -320,6 +386,56 @@ def _leader_track(beacon: str, world, leash: float, speed: float, duration: floa
         _warn(f"the leader's track runs to t = {track.t[-1]:g} s, after the log ends at {duration:g} s: the "
               "swarm explores only part of it (give a longer --duration)", quiet)
     return track
+
+
+@app.command(epilog="Example: swarmtopo perturb runs/two-holes --out runs/two-holes-faulty --lost 0.3 --jitter 0.5 "
+                    "--false-encounters 0.01 --seed 1 && swarmtopo map runs/two-holes-faulty")
+def perturb(
+    log_dir: Path = typer.Argument(..., help="Log folder (simulated or ingested)."),
+    out_dir: Path = typer.Option(..., "--out", help="Folder to write the perturbed log into (created)."),
+    lost: float = FAULT_OPTIONS["lost"],
+    burst_lost: float = FAULT_OPTIONS["burst_lost"],
+    burst_length: float = FAULT_OPTIONS["burst_length"],
+    false_encounters: float = FAULT_OPTIONS["false_encounters"],
+    jitter: float = FAULT_OPTIONS["jitter"],
+    clock_offset: float = FAULT_OPTIONS["clock_offset"],
+    clock_drift: float = FAULT_OPTIONS["clock_drift"],
+    dying: float = FAULT_OPTIONS["dying"],
+    duplicated: float = FAULT_OPTIONS["duplicated"],
+    duplicate_delay: float = FAULT_OPTIONS["duplicate_delay"],
+    seed: int = typer.Option(0, "--seed", min=0, help="Random seed of the faults (same seed, same bytes)."),
+    fmt: str = typer.Option("csv", "--format", callback=_fmt_option, help="csv or parquet."),
+    overwrite: bool = typer.Option(False, "--overwrite", help=OVERWRITE_HELP),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
+) -> None:
+    """Pass a log's encounters through a faulty radio: lost, false, late and duplicated reports, dying agents.
+
+    Each encounter is one report, sent by one of its two agents and stamped by that
+    agent's clock; the faults are applied in turn and recorded in the new log's
+    meta.json (docs/model.md in the source repository, 'Faulty sensing').  The arena
+    (arena.geojson) is copied; truth.* (true positions per true event) is not.
+    """
+    import shutil
+
+    from .io.logs import log_folder, read_log, write_log
+    from .sim.faults import perturb as apply_faults
+
+    faults = _check_option("--lost ... --duplicate-delay", _faults, locals())
+    if not faults.any:
+        raise typer.BadParameter("no fault given: set at least one of --lost, --burst-lost, --false-encounters, "
+                                 "--jitter, --clock-offset, --clock-drift, --dying, --duplicated")
+    source = log_folder(log_dir)
+    log = read_log(source)
+    with _staged_log(out_dir, overwrite, protect=[source / name for name in ("meta.json",)]) as stage:
+        faulty, record = apply_faults(log, faults, seed)
+        written = [stage.final_path(p) for p in write_log(faulty, stage.path, fmt=fmt)]
+        if (source / "arena.geojson").is_file():
+            shutil.copyfile(source / "arena.geojson", stage.path / "arena.geojson")
+            written.append(stage.final_path(stage.path / "arena.geojson"))
+    _say_removed(stage, quiet)
+    if not quiet:
+        out.print(_fault_counts(record), markup=False, highlight=False, soft_wrap=True)
+        out.print(f"wrote {', '.join(str(p) for p in written)}", markup=False, highlight=False, soft_wrap=True)
 
 
 @app.command(epilog="Example: swarmtopo ingest primaryschool.csv --format sociopatterns --out runs/school "
@@ -458,6 +574,10 @@ def map_command(
         "recontacts", "auto|merge|keep",
         "A pair's repeated contact starts (contacts that flicker, as with diffusive or flocking agents): 'auto' "
         "(default) merges each into the pair's first when the log's contacts flicker, 'merge' always, 'keep' never."),
+    uncorroborated: Optional[str] = _map_option(
+        "uncorroborated", "auto|drop|keep",
+        "Encounters no short detour through the rest of the log backs (false encounters, timing errors): 'auto' "
+        "(default) leaves them out when their share says the sensing was faulty, 'drop' always, 'keep' never."),
     classifier: Optional[str] = typer.Option(
         None, "--classifier",
         help="Betti reader: default (tuned on the accuracy benchmark), trace (the same tuned on its logs read as "
@@ -494,7 +614,8 @@ def map_command(
                "wall_follow_weight": wall_follow_weight, "window_length": window_length,
                "window_encounters": window_encounters, "window_scales": window_scales, "window_step": window_step,
                "max_windows": max_windows, "landmark_bands": landmark_bands, "max_landmarks": max_landmarks,
-               "timeline_length": timeline_length, "timeline_step": timeline_step, "recontacts": recontacts}
+               "timeline_length": timeline_length, "timeline_step": timeline_step, "recontacts": recontacts,
+               "uncorroborated": uncorroborated}
     if paper:
         given = [_option_name(name) for name in PAPER_EXCLUDES if options[name] is not None]
         if given or classifier is not None:
@@ -916,6 +1037,42 @@ def bench_motion(
     if split not in ("reporting", "tuning"):
         raise typer.BadParameter("must be reporting or tuning", param_hint="--split")
     _bench_report("motion", out_dir, store, quiet, verbose, markdown,
+                  run=lambda tick: run_benchmark(store, quick=quick, split=split, scheduler=scheduler,
+                                                 workers=workers, progress=tick))
+
+
+@bench_app.command("faults", epilog="Example: swarmtopo bench faults --quick --store faults.duckdb --workers 2  "
+                                    "(run it again after Ctrl-C: finished maps are kept)")
+def bench_faults(
+    quick: bool = typer.Option(False, "--quick", help="1 case per hole count and level instead of 4 (10 for faults "
+                                                      "together)."),
+    split: str = typer.Option("reporting", "--split", help="reporting, or tuning (cases of their own seeds)."),
+    store: Path = typer.Option(Path("faults.duckdb"), "--store", help="DuckDB result store (resumable)."),
+    out_dir: Path = typer.Option(Path("faults"), "--out", help="Folder for faults.md, faults.json and faults.png."),
+    scheduler: Optional[str] = DASK_SCHEDULER_OPTION,
+    workers: Optional[int] = LOCAL_WORKERS_OPTION,
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="Print nothing but errors."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help=VERBOSE_HELP),
+) -> None:
+    """How the map degrades when the radio loses, invents, delays and duplicates reports.
+
+    Simulates the accuracy benchmark's arenas (0-3 holes, 300 cockroaches x 40 s), passes
+    each log through a faulty radio at every level of a grid (lost 15-60 %, outages, false
+    encounters 0.5-5 %, jitter 0.25-2 s, clock offsets 1-5 s, 10-30 % of agents dying,
+    duplicates, and faults together), maps the encounters only on Dask; prints per level
+    the share of exact maps, the confidence's Brier score against a constant, confidently
+    wrong maps and the logs read as faulty, and plots the curves (faults.png).
+    """
+    from .experiments.faults import markdown, plot, run_benchmark
+
+    if split not in ("reporting", "tuning"):
+        raise typer.BadParameter("must be reporting or tuning", param_hint="--split")
+
+    def figure(summary, command, folder):
+        plot(summary, folder / "faults.png")
+        return [folder / "faults.png"]
+
+    _bench_report("faults", out_dir, store, quiet, verbose, markdown, extra_files=("faults.png",), extra=figure,
                   run=lambda tick: run_benchmark(store, quick=quick, split=split, scheduler=scheduler,
                                                  workers=workers, progress=tick))
 

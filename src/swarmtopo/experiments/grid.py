@@ -60,7 +60,20 @@ Format (``examples/sweep-small.toml`` is a commented example)::
     maxdim = 1                # highest homology dimension, 1 or 2 (default 1)
     classifier = "default"    # "default", "paper", or a classifier JSON file
 
-Every value of ``[arena]``, ``[swarm]`` and ``[map]`` may be a scalar or a list; lists
+    [faults]                  # the simulated log through a faulty radio (swarmtopo.sim.faults;
+                              # every level 0 by default: no fault, and the job's config has no [faults])
+    lost = 0.0                # share of reports lost independently
+    burst_lost = 0.0          # share of each radio's time down (its reports lost)
+    burst_length = 2.0        # mean outage, s (only with burst_lost > 0)
+    false_encounters = 0.0    # false reports of pairs that never met, per report
+    jitter = 0.0              # s, standard deviation of each report's time noise
+    clock_offset = 0.0        # s, each agent's clock off by up to this (uniform)
+    clock_drift = 0.0         # s per s, each agent's clock drifting by up to this
+    dying = 0.0               # share of agents whose battery dies at a random time
+    duplicated = 0.0          # share of reports delivered twice
+    duplicate_delay = 0.5     # s, a duplicate's delay at most (only with duplicated > 0)
+
+Every value of ``[arena]``, ``[swarm]``, ``[map]`` and ``[faults]`` may be a scalar or a list; lists
 expand into the Cartesian product of all lists, times ``replicates``.  ``shapes`` is a
 set of hole families, each hole drawing its family uniformly from the set: a string
 or a list of strings is one set (``["square", "disc"]``: every arena mixes squares and
@@ -85,7 +98,7 @@ Job identity.  ``job.key`` is the SHA-256 (hex) of the canonical JSON of (config
 replicate, salt); ``job.seed`` is the first 64 bits of the same hash.  Neither depends
 on the job's position in the grid, so growing a grid never changes finished jobs.
 The job's randomness comes from ``np.random.SeedSequence(job.seed)``, spawned into
-independent streams (arena, simulation, map): see :meth:`Job.stream_seeds`.
+independent streams (arena, simulation, map, faults): see :meth:`Job.stream_seeds`.
 """
 
 from __future__ import annotations
@@ -109,6 +122,7 @@ from ..readers.registry import PRESETS, load_classifier
 from ..errors import InputError, SwarmtopoError
 from ..io import read_arena
 from ..pipeline.config import OPTIONS, ConfigError, MapConfig, config_from_options
+from ..sim.faults import FAULT_LEVELS, FAULT_SHARES, Faults
 from ..sim.params import MOTION_MODELS, MOTION_OPTIONS, make_motion
 from ..sim.simulate import check_parameters
 
@@ -123,7 +137,7 @@ GENERATORS: dict[str, tuple[str, ...]] = {
     "hall": ("holes", "shapes", "length", "width"),
 }
 """Arena generators and the ``[arena]`` keys each one uses (besides ``generator``)."""
-STREAMS = ("arena", "simulation", "map")
+STREAMS = ("arena", "simulation", "map", "faults")
 """The independent random streams of a job, in :meth:`Job.stream_seeds` order."""
 STORE_INT_MAX = int(np.iinfo(np.int32).max)
 """Bound of every integer key: the store's INTEGER columns are 32-bit."""
@@ -240,9 +254,11 @@ PARAMS: tuple[Param, ...] = (
         ("window_step", "auto", "DOUBLE"), ("subsample", "maxmin", "TEXT"), ("landmarks", "auto", "INTEGER"),
         ("max_landmarks", MapConfig().max_landmarks, "INTEGER"), ("maxdim", 1, "INTEGER"))),
     Param("map", "classifier", "default", _text, "TEXT"),
+    *(Param("faults", name, getattr(Faults(), name), _number(0.0, strict=False, hi=1.0 if name in FAULT_SHARES else None),
+            "DOUBLE") for name in Faults.__dataclass_fields__),
 )
 """Every grid key, in expansion order (the last key varies fastest)."""
-GRID_TABLES = ("arena", "swarm", "map")
+GRID_TABLES = ("arena", "swarm", "map", "faults")
 SWEEP_KEYS = ("name", "replicates", "salt", "job_timeout", "diagrams")
 DEFAULT_JOB_TIMEOUT = 3600.0
 """Seconds a job may run before it is killed and stored as a "timeout" row (``[sweep]
@@ -275,7 +291,7 @@ class Job:
         ``(key, absolute path)`` of the job's input files (``arena.path``,
         ``map.classifier``); not part of the key, whose config holds their SHA-256.
     case_seed
-        Seed of the arena and simulation streams shared by jobs that map the same
+        Seed of the arena, simulation and faults streams shared by jobs that map the same
         simulated case in different ways (the accuracy benchmark's pipelines); None:
         every stream comes from the job's own seed.  Part of the key when set.
     """
@@ -304,8 +320,8 @@ class Job:
 
     def stream_seeds(self) -> dict[str, int]:
         """Independent seeds of the job's streams (``STREAMS``), spawned from
-        ``SeedSequence(seed)``: one 64-bit integer each.  With ``case_seed`` the arena
-        and simulation streams are spawned from it instead (:func:`case_streams`)."""
+        ``SeedSequence(seed)``: one 64-bit integer each.  With ``case_seed`` the arena,
+        simulation and faults streams are spawned from it instead (:func:`case_streams`)."""
         children = np.random.SeedSequence(self.seed).spawn(len(STREAMS))
         seeds = {name: int(child.generate_state(1, np.uint64)[0]) for name, child in zip(STREAMS, children)}
         if self.case_seed is not None:
@@ -336,9 +352,11 @@ def suite_case_seed(suite: str, cell: str, split: str, index: int, attempt: int 
 
 
 def case_streams(case_seed: int) -> dict[str, int]:
-    """The arena and simulation seeds of a shared case (``Job.case_seed``)."""
-    children = np.random.SeedSequence(case_seed).spawn(2)
-    return {name: int(child.generate_state(1, np.uint64)[0]) for name, child in zip(("arena", "simulation"), children)}
+    """The arena, simulation and faults seeds of a shared case (``Job.case_seed``): one
+    case perturbed at several fault levels draws its faults from one stream."""
+    children = np.random.SeedSequence(case_seed).spawn(3)
+    return {name: int(child.generate_state(1, np.uint64)[0])
+            for name, child in zip(("arena", "simulation", "faults"), children)}
 
 
 @dataclass(frozen=True)
@@ -600,7 +618,14 @@ def _canonical(point: dict, inputs: _InputFiles, fail):
         files.append(("map.classifier", absolute))
 
     config = {"arena": arena, "swarm": swarm, "map": mapping}
-    used = {(table, key) for table, body in config.items() for key in body} | {("swarm", "leash")}  # 0: no leader
+    faults = {name: point[("faults", name)] for name in FAULT_LEVELS}
+    if any(faults.values()):  # a job without faults has the config it had before faults existed
+        config["faults"] = {name: value for name, value in faults.items() if value}
+        for name, level in (("burst_length", "burst_lost"), ("duplicate_delay", "duplicated")):
+            if faults[level]:
+                config["faults"][name] = point[("faults", name)]
+    used = ({(table, key) for table, body in config.items() for key in body} | {("swarm", "leash")}  # 0: no leader
+            | {("faults", name) for name in FAULT_LEVELS})  # 0: no such fault
     return config, tuple(files), used
 
 
@@ -609,7 +634,8 @@ def _check_job(config: dict, document: dict, fail) -> None:
     (:func:`job_simulation_args`) and the map's (:func:`job_map_config`); a failure names
     the table's keys given in the file, with this job's values."""
     checks = {"swarm": lambda: check_parameters(**job_simulation_args(config["swarm"])),
-              "map": lambda: job_map_config(config["map"]).validate()}
+              "map": lambda: job_map_config(config["map"]).validate(),
+              "faults": lambda: Faults(**config.get("faults", {}))}
     for table, check in checks.items():
         try:
             check()
@@ -634,6 +660,10 @@ def _unused_reason(table: str, key: str, document: dict) -> str:
         users = [name for name, model in MOTION_MODELS.items()
                  if MOTION_OPTIONS[key] in getattr(model, "__dataclass_fields__", {}) and name != "cockroach"]
         return f"not used by this motion model (only by {', '.join(repr(u) for u in users)})"
+    if key == "burst_length":
+        return "not used: burst_lost is 0 (no outages)"
+    if key == "duplicate_delay":
+        return "not used: duplicated is 0 (no duplicated report)"
     if key in ("window_step", "window_scales"):
         return 'not used: window_length is "none" (the whole log at once)'
     if key == "window_encounters":

@@ -62,6 +62,8 @@ from ..errors import SwarmtopoError
 from ..topology.persistence import Diagram
 from .grid import PARAMS
 
+FAULT_PARAMS = tuple(p.name for p in PARAMS if p.table == "faults")
+
 STATUSES = ("ok", "error", "crashed", "timeout")
 FAILURES = STATUSES[1:]
 """Kinds of failed rows."""
@@ -75,6 +77,7 @@ _RESULTS = (
     ("snr_h1", "DOUBLE"), ("noise_power_h1", "DOUBLE"), ("lengths_h1", "DOUBLE[]"),
     ("diagrams", "BLOB"), ("diagrams_kept", "TEXT"), ("timeline", "JSON"), ("exploration", "JSON"),
     ("motion_estimate", "JSON"),
+    ("sensing", "JSON"),
     ("n_events", "INTEGER"), ("n_agents", "INTEGER"), ("n_regions", "INTEGER"), ("n_landmarks", "INTEGER"),
     ("t_simulate", "DOUBLE"), ("t_graph", "DOUBLE"), ("t_landmarks", "DOUBLE"), ("t_persistence", "DOUBLE"),
     ("t_classify", "DOUBLE"), ("t_total", "DOUBLE"),
@@ -83,7 +86,7 @@ _RESULTS = (
 )
 JOB_COLUMNS: tuple[tuple[str, str], ...] = (*_IDENTITY, *((p.name, p.sql) for p in PARAMS), *_RESULTS)
 """(name, DuckDB type) of every column of ``jobs``, in order."""
-JSON_COLUMNS = ("config", "versions", "timeline", "exploration", "motion_estimate")
+JSON_COLUMNS = ("config", "versions", "timeline", "exploration", "motion_estimate", "sensing")
 """Columns holding JSON text; :func:`iter_jobs` returns them parsed."""
 RUN_COLUMNS = ("t_simulate", "t_graph", "t_landmarks", "t_persistence", "t_classify", "t_total",
                "versions", "worker", "finished_at")
@@ -527,7 +530,7 @@ def _tables(db) -> set[str]:
 
 NEW_COLUMNS = ("change", "change_time", "timeline", "length", "width", "leash", "leader_speed", "exploration", "motion",
                "speed", "tumble_rate", "diffusion", "levy_exponent", "levy_min_step", "align_radius", "noise",
-               "motion_estimate")
+               "motion_estimate", *FAULT_PARAMS, "sensing")
 """Columns added since stores had a runs table: a store without them gets them (NULL)
 when a sweep opens it, so its finished jobs are kept."""
 

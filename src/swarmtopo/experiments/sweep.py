@@ -46,8 +46,9 @@ from ..topology.persistence import snr
 from ..pipeline import MapConfig, map_encounters
 from ..pipeline.engine import POLL_SECONDS, connected_client, deferred_interrupt, local_client
 from ..pipeline.result import software_versions
-from ..viz.summary import exploration_json, motion_json, timeline_json, window_json
+from ..viz.summary import exploration_json, motion_json, sensing_json, timeline_json, window_json
 from ..sim import simulate
+from ..sim.faults import Faults, perturb
 from .grid import (DEFAULT_JOB_TIMEOUT, KEEP_LEVELS, Job, canonical_json, case_streams, flat_columns, job_map_config,
                    job_simulation_args, suite_case_seed)
 from .isolation import JobProcess, one_line
@@ -189,8 +190,9 @@ def job_classifier(mapping: dict[str, Any]) -> str:
 def run_job(job: Job, keep: str = "map") -> dict[str, Any]:
     """Simulate and map one job; its row of the store's ``jobs`` table.
 
-    Streams (:meth:`Job.stream_seeds`): the arena's holes, the simulation, and the
-    map's landmark start.  The map uses no picture (``embed_dim = 0``) and the
+    Streams (:meth:`Job.stream_seeds`): the arena's holes, the simulation, the map's
+    landmark start and the faults (a ``[faults]`` table: the simulated log goes through
+    :func:`~swarmtopo.sim.faults.perturb` before it is mapped).  The map uses no picture (``embed_dim = 0``) and the
     classifier named in ``config["map"]["classifier"]`` ("default": the shipped one for the
     log read, as ``map``'s: ``trace`` for a contact trace), reading the stripped log folder or,
     with ``config["map"]["input"] = "contact-trace"`` (``INPUTS``; set by benchmark code,
@@ -215,10 +217,11 @@ def run_job(job: Job, keep: str = "map") -> dict[str, Any]:
             leader = {"leash": swarm["leash"],
                       "beacon": long_axis_track(arena.bounds, swarm["leash"], swarm["leader_speed"])}
         sim = simulate(arena, **job_simulation_args(swarm), **leader, rng=seeds["simulation"])
+        log = perturb(sim.log, Faults(**config["faults"]), seeds["faults"])[0] if "faults" in config else sim.log
         row["t_simulate"] = time.perf_counter() - t0
-        row["n_events"], row["n_agents"] = sim.log.n_events, sim.log.n_agents
+        row["n_events"], row["n_agents"] = log.n_events, log.n_agents
         true_timeline = betti_timeline_of(arena, sim.log.meta["duration"])
-        log = stripped_log(sim.log)
+        log = stripped_log(log)
         tmap = map_encounters(contact_trace(log) if map_input(mapping) == "contact-trace" else log,
                               job_map_config(mapping, seeds["map"]),
                               reader=cached_classifier(job_classifier(mapping), job.file("map.classifier")))
@@ -241,7 +244,7 @@ def run_job(job: Job, keep: str = "map") -> dict[str, Any]:
             diagrams=encode_regions(regions), diagrams_kept=keep,
             timeline=timeline_record(tmap.timeline, true_timeline, keep),
             exploration=exploration_record(tmap.exploration, arena, keep) if tmap.exploration else None,
-            motion_estimate=motion_json(tmap.motion),
+            motion_estimate=motion_json(tmap.motion), sensing=sensing_json(tmap.sensing),
             n_regions=len(tmap.regions), n_landmarks=sum(region["landmarks"] for region in regions),
             **{column: tmap.timings[stage] for stage, column in _STAGE_COLUMNS.items()},
         )

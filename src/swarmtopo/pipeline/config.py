@@ -24,6 +24,9 @@ from ..metric.landmarks import SUBSAMPLERS
 
 RECONTACTS = ("auto", "merge", "keep")
 """``MapConfig.recontacts``: merge a flickering log's repeated contact starts (``auto``), always, or never."""
+UNCORROBORATED = ("auto", "drop", "keep")
+"""``MapConfig.uncorroborated``: drop the encounters the rest of the log does not back when the log shows
+faulty sensing (``auto``), always, or never."""
 
 MAX_HOP_COST, MAX_WALL_FOLLOW_WEIGHT = 1e9, 1e6
 """Bounds of the per-hop cost (s, about 30 years) and of the wall-following charge (s/s):
@@ -134,6 +137,10 @@ class MapConfig:
         What to do with a pair's repeated contact starts (:mod:`.motion`): ``auto``
         (default) merges them when the log's contacts flicker (diffusive or flocking
         agents), ``merge`` always, ``keep`` never (the paper).
+    uncorroborated
+        What to do with the encounters the rest of the log does not back (:mod:`.faults`):
+        ``auto`` (default) drops them when their share says the sensing was faulty,
+        ``drop`` always, ``keep`` never (the paper).
     """
 
     metric: str = "hybrid"
@@ -161,6 +168,7 @@ class MapConfig:
     timeline_length: float | None = None
     timeline_step: float | None = None
     recontacts: str = "auto"
+    uncorroborated: str = "auto"
 
     def __post_init__(self):
         for name in ("window_scales", "landmark_bands"):
@@ -220,6 +228,8 @@ class MapConfig:
                                f"window per length), or None; got {self.max_windows}")
         if self.recontacts not in RECONTACTS:
             bad("recontacts", f"must be one of {', '.join(RECONTACTS)}, got {self.recontacts!r}")
+        if self.uncorroborated not in UNCORROBORATED:
+            bad("uncorroborated", f"must be one of {', '.join(UNCORROBORATED)}, got {self.uncorroborated!r}")
         if self.maxdim not in (1, 2):
             bad("maxdim", f"must be 1 or 2, got {self.maxdim}")
         if self.embed_dim not in (0, 2, 3):
@@ -235,7 +245,8 @@ class MapConfig:
 
 
 PAPER_OPTIONS = {"hop_cost": 0.0, "diffusion_time": "none", "wall_follow_weight": "none", "window_length": "none",
-                 "window_scales": (1.0,), "landmark_bands": (1.0,), "recontacts": "keep"}
+                 "window_scales": (1.0,), "landmark_bands": (1.0,), "recontacts": "keep",
+                 "uncorroborated": "keep"}
 """The options of the paper's pipeline (no per-hop cost, no diffusive weights, wall
 following like any time, the whole log at once, whole-window landmarks), read with the
 ``paper`` reader (``swarmtopo map --paper``)."""
@@ -395,6 +406,7 @@ OPTIONS: dict[str, Option] = {option.name: option for option in (
     Option("timeline_step", _number(0.0, strict=True), {"auto": None}),
     Option("seed", _integer(0)),
     Option("recontacts", _choice(RECONTACTS)),
+    Option("uncorroborated", _choice(UNCORROBORATED)),
 )}
 """Every option users may set by name, with its parser."""
 

@@ -33,13 +33,14 @@ from ..metric.graph import weighted_chains
 from ..metric.landmarks import MIN_LANDMARKS
 from ..readers.base import BettiReader
 from ..readers.beta0 import shipped_beta0_model
-from ..readers.recalibrated import Recalibrated, flicker_recalibration
+from ..readers.recalibrated import Recalibrated, fault_recalibration, flicker_recalibration
 from ..readers.registry import load_classifier, shipped_reader_for
 from ..topology.cycles import region_cycles
 from ..topology.embed import mds
 from ..topology.persistence import Diagram, rips_persistence
 from .config import MapConfig
 from .engine import engine_for
+from .faults import fault_warnings, screen_faults
 from .motion import estimate_motion, motion_warnings
 from .exploration import MAX_EXPLORATION_WINDOWS, exploration_windows, leash_of, stitch
 from .regions import MIN_REGION_AGENTS, split_regions
@@ -98,9 +99,13 @@ def map_encounters(
     config = (config or MapConfig()).validate()
     reader = reader or load_classifier(shipped_reader_for(log))
     motion, log = estimate_motion(log, config.recontacts, config.window)
-    if motion.regime == "flickering" and motion.merged and getattr(reader, "shipped_preset", None):
-        reader = flicker_recalibration(reader.shipped_preset, reader) or reader
-    recalibrated = isinstance(reader, Recalibrated)
+    screen, log = screen_faults(log, config.uncorroborated, config.window)
+    preset = getattr(reader, "shipped_preset", None)
+    if screen.suspected and preset:  # faulty sensing first: its fit saw the faults, the flicker's did not
+        reader = fault_recalibration(preset, reader, screen.uncorroborated_share, screen.far_share) or reader
+    elif motion.regime == "flickering" and motion.merged and preset:
+        reader = flicker_recalibration(preset, reader) or reader
+    recalibration = reader.kind if isinstance(reader, Recalibrated) else None
     settings = resolve(log, config, reader)
     leash = leash_of(log)
     span = (float(settings.times[0]), float(settings.times[-1]))
@@ -157,15 +162,15 @@ def map_encounters(
     length, step = timeline_settings(timeline_config, settings.window_length[0])
     timeline = build_timeline(timeline_windows, length, step, betti, confidence, log,
                               note=None if timeline_windows else no_timeline_note(timeline_config, length))
-    warnings = (motion_warnings(motion, recalibrated) + silence_warnings(settings.times, settings.window_length[0])
-                + _extrapolation_warnings(betti))
+    warnings = (motion_warnings(motion, recalibration == "flicker") + fault_warnings(screen, recalibration == "fault")
+                + silence_warnings(settings.times, settings.window_length[0]) + _extrapolation_warnings(betti))
     exploration = None
     if leash is not None and betti.get(1) is not None:
         exploration = stitch(timeline.windows, log.beacon, leash, length, step, len(regions), log.meta, span)
         if exploration.betti[1] is not None:  # the global map's count is the answer
             betti[1], confidence[1] = exploration.betti[1], None
-            warnings = (motion_warnings(motion, recalibrated)
-                        + silence_warnings(settings.times, settings.window_length[0]))
+            warnings = (motion_warnings(motion, recalibration == "flicker")
+                        + fault_warnings(screen, recalibration == "fault") + silence_warnings(settings.times, settings.window_length[0]))
     elif (log.beacon is None) != ("leash" not in log.meta):
         warnings.append("the log has " + ("a leader's track (beacon.csv) but no 'leash' in meta.json"
                                           if log.beacon is not None else "a 'leash' in meta.json but no beacon.csv")
@@ -193,6 +198,7 @@ def map_encounters(
         timeline=timeline,
         exploration=exploration,
         motion=motion,
+        sensing=screen,
     )
 
 

@@ -19,6 +19,7 @@ from ..topology.cycles import Cycle
 from ..topology.embed import Embedding
 from ..topology.persistence import Diagram, PersistenceResult
 from .config import WHOLE_LOG, MapConfig
+from .faults import FaultScreen
 from .motion import MotionEstimate
 
 
@@ -245,6 +246,7 @@ class TopologicalMap:
     timeline: Timeline | None = None  # Betti numbers over sliding windows, change points (pipeline.timeline)
     exploration: Exploration | None = None  # the global map of a beacon-led log (pipeline.exploration)
     motion: MotionEstimate | None = None  # what the encounters say about the agents' motion (pipeline.motion)
+    sensing: FaultScreen | None = None  # what the encounters say about faulty sensing (pipeline.faults)
 
     @property
     def warnings(self) -> list[str]:

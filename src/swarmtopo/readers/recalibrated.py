@@ -1,4 +1,5 @@
-"""A shipped reader's beta_1 confidence recalibrated for logs whose contacts flicker.
+"""A shipped reader's beta_1 confidence recalibrated for logs whose contacts flicker,
+or whose sensing was faulty.
 
 The shipped readers' confidences were calibrated on cockroach logs.  On logs whose
 contacts flicker (:mod:`swarmtopo.pipeline.motion`: Brownian and flocking swarms) they
@@ -14,6 +15,15 @@ maps of the motion benchmark (``swarmtopo/data/flicker-confidence.json``); the c
 are the reader's own.  A map's confidence is then the reader's combination of the
 recalibrated regions' (``map_confidence``), and its timeline's windows are read the
 same way.
+
+Faulty sensing (:mod:`swarmtopo.pipeline.faults`) is recalibrated likewise, with the
+fault screen's shares as two more terms:
+
+    p' = sigmoid(a + b logit p + c u + d f),
+
+u the share of uncorroborated encounters and f that of far ones, fitted per preset by
+``lab/calibrate_faults.py`` on the maps of the fault benchmark's tuning cases that the
+screen reads as faulty (``swarmtopo/data/fault-confidence.json``).
 """
 
 from __future__ import annotations
@@ -29,6 +39,7 @@ from ..topology.persistence import Diagram
 from .base import BettiReader, RegionReading
 
 FLICKER_FORMAT = "swarmtopo-flicker-confidence/1"
+FAULT_FORMAT = "swarmtopo-fault-confidence/1"
 
 
 @dataclass(frozen=True)
@@ -39,6 +50,7 @@ class Recalibrated:
     intercept: float
     slope: float
     provenance: dict[str, Any]
+    kind: str = "flicker"
 
     @property
     def landmark_bands(self) -> tuple[float, ...]:
@@ -59,14 +71,14 @@ class Recalibrated:
         return self.reader.map_confidence(confidences, n)
 
     def describe(self) -> dict[str, Any]:
-        return {**self.reader.describe(), "flicker_recalibration": {"intercept": self.intercept, "slope": self.slope,
-                                                                    **self.provenance}}
+        return {**self.reader.describe(), f"{self.kind}_recalibration": {"intercept": self.intercept,
+                                                                         "slope": self.slope, **self.provenance}}
 
 
 def flicker_recalibration(preset: str, reader: BettiReader) -> Recalibrated | None:
     """The shipped preset ``preset``'s ``reader`` recalibrated for flickering logs (None:
     no fit shipped for that preset)."""
-    fits = _fits()
+    fits = _fits("flicker-confidence.json", FLICKER_FORMAT)
     if preset not in fits["presets"]:
         return None
     fit = fits["presets"][preset]
@@ -74,9 +86,23 @@ def flicker_recalibration(preset: str, reader: BettiReader) -> Recalibrated | No
                         {"maps": fit["maps"], "script": fits["script"], "fitted_on": fits["fitted_on"]})
 
 
-@lru_cache(maxsize=1)
-def _fits() -> dict[str, Any]:
-    text = resources.files("swarmtopo.data").joinpath("flicker-confidence.json").read_text("utf-8")
+def fault_recalibration(preset: str, reader: BettiReader, uncorroborated: float, far: float) -> Recalibrated | None:
+    """The shipped preset ``preset``'s ``reader`` recalibrated for a log with faulty sensing
+    whose screen read shares ``uncorroborated`` (u) and ``far`` (f) (None: no fit shipped
+    for that preset)."""
+    fits = _fits("fault-confidence.json", FAULT_FORMAT)
+    if preset not in fits["presets"]:
+        return None
+    fit = fits["presets"][preset]
+    intercept = fit["intercept"] + fit["uncorroborated"] * uncorroborated + fit["far"] * far
+    return Recalibrated(reader, intercept, fit["slope"],
+                        {"uncorroborated_share": uncorroborated, "far_share": far, "maps": fit["maps"],
+                         "script": fits["script"], "fitted_on": fits["fitted_on"]}, kind="fault")
+
+
+@lru_cache(maxsize=2)
+def _fits(name: str, form: str) -> dict[str, Any]:
+    text = resources.files("swarmtopo.data").joinpath(name).read_text("utf-8")
     fits = json.loads(text)
-    assert fits["format"] == FLICKER_FORMAT, fits["format"]
+    assert fits["format"] == form, fits["format"]
     return fits

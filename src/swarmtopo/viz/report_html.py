@@ -197,6 +197,9 @@ def _verdict_section(doc: dict, arena, true_timeline: list | None = None) -> str
     if doc.get("motion"):
         lines.append(f'<p class="motion" data-regime="{doc["motion"]["regime"]}">'
                      f'{html.escape(doc["motion"]["summary"])}</p>')
+    if doc.get("sensing"):
+        lines.append(f'<p class="sensing" data-suspected="{str(doc["sensing"]["suspected"]).lower()}">'
+                     f'{html.escape(doc["sensing"]["summary"])}</p>')
     for warning in doc["warnings"]:
         lines.append(f'<p class="warning">warning: {html.escape(warning)}</p>')
     for small in doc["too_little_data"]:

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from .._json import jsonable
+from ..pipeline.faults import FaultScreen
 from ..pipeline.motion import MotionEstimate
 from ..pipeline.result import Exploration, RegionMap, Timeline, TopologicalMap, WindowMap
 from ..readers.beta0 import BETA0_DEFINITION
@@ -73,6 +74,7 @@ def map_json(tmap: TopologicalMap) -> dict[str, Any]:
         "timeline": None if tmap.timeline is None else timeline_json(tmap.timeline),
         "exploration": None if tmap.exploration is None else exploration_json(tmap.exploration),
         "motion": None if tmap.motion is None else motion_json(tmap.motion),
+        "sensing": None if tmap.sensing is None else sensing_json(tmap.sensing),
         "beta0_evidence": None if tmap.beta0_evidence is None else {**tmap.beta0_evidence.to_json(),
                                                                       "definition": BETA0_DEFINITION},
         "params": {**jsonable(asdict(tmap.config)), "hop_cost_used": tmap.hop_cost[0],
@@ -92,6 +94,13 @@ def motion_json(motion: MotionEstimate) -> dict[str, Any]:
     return {"regime": motion.regime, "summary": motion.describe(), "recontact_share": motion.recontact_share,
             "median_gap": motion.median_gap, "encounter_rate": motion.encounter_rate,
             "partners_per_agent": motion.partners_per_agent, "merged": motion.merged}
+
+
+def sensing_json(screen: FaultScreen) -> dict[str, Any]:
+    """map.json's ``sensing``: what the encounters say about faulty sensing."""
+    return {"summary": screen.describe(), "uncorroborated_share": screen.uncorroborated_share,
+            "far_share": screen.far_share, "duplicate_share": screen.duplicate_share, "suspected": screen.suspected,
+            "dropped": screen.dropped, "merged": screen.merged}
 
 
 def timeline_json(timeline: Timeline) -> dict[str, Any]:
