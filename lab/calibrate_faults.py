@@ -1,7 +1,7 @@
 """Fit the beta_1 confidence of the shipped readers on logs with faulty sensing
-(``swarmtopo.readers.recalibrated``): p' = sigmoid(a + b logit p + c u + d f).
+(``swarmtopo.readers.recalibrated``): Platt scaling p' = sigmoid(a + b logit p).
 
-    python lab/calibrate_faults.py --store faults-cal.duckdb --per-cell 3 --workers 2 [--write]
+    python lab/calibrate_faults.py --store faults-cal.duckdb --per-cell 3 --workers 2 [--features] [--write]
 
 Runs (resumably, windows' diagrams kept) the fault benchmark's *tuning* cases at every
 fault level twice: read as contact traces (the ``trace`` reader) and as log folders
@@ -9,10 +9,11 @@ fault level twice: read as contact traces (the ``trace`` reader) and as log fold
 (``swarmtopo.pipeline.faults``: far share above CLEAN_FAR_SHARE or uncorroborated share
 above POOR_SHARE) and that find one region (the map's confidence is then the region's,
 to which the recalibration applies), it reads the windows again with the raw preset,
-fits (a, b, c, d) by logistic regression of "beta_1 right" on (logit p, u, f), and
-prints the 5-fold cross-validated Brier score against the raw confidence and a
-constant, and the wrong maps said at 0.95 or more.  ``--write`` writes
-swarmtopo/data/fault-confidence.json.
+fits (a, b) by logistic regression of "beta_1 right" on logit p, and prints the 5-fold
+cross-validated Brier score against the raw confidence and a constant, and the wrong
+maps said at 0.95 or more.  ``--features`` also prints the cross-validated Brier score
+with the screen's shares u (uncorroborated) and f (far) as more terms.  ``--write``
+writes swarmtopo/data/fault-confidence.json.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ import numpy as np
 from sklearn.linear_model import LogisticRegression
 from sklearn.model_selection import cross_val_predict
 
+from calibrate_flicker import clipped_logit
 from swarmtopo.experiments.accuracy import PIPELINES, TRACE_PIPELINE
 from swarmtopo.experiments.faults import SUITE, jobs
 from swarmtopo.experiments.store import read_jobs
@@ -36,11 +38,6 @@ READINGS = {"trace": TRACE_PIPELINE, "default": PIPELINES["default"]}
 OUT = Path(__file__).resolve().parent.parent / "src" / "swarmtopo" / "data" / "fault-confidence.json"
 COLUMNS = ("key", "config", "diagrams", "error", "est_betti0", "true_betti0", "true_betti1", "sensing")
 CONFIDENT = 0.95
-
-
-def clipped_logit(p: np.ndarray) -> np.ndarray:
-    p = np.clip(p, 1e-9, 1 - 1e-9)
-    return np.log(p / (1 - p))
 
 
 def raw_confidences(rows, preset: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -66,6 +63,7 @@ def main() -> None:
     parser.add_argument("--store", required=True)
     parser.add_argument("--per-cell", type=int, default=3)
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--features", action="store_true", help="also score the fit with u and f as terms")
     parser.add_argument("--write", action="store_true")
     args = parser.parse_args()
     fits = {}
@@ -74,15 +72,20 @@ def main() -> None:
         run_sweep(todo, args.store, workers=args.workers, keep="windows")
         rows = read_jobs(args.store, columns=COLUMNS, keys=[job.key for job in todo])
         x, y, p = raw_confidences(rows, preset)
-        model = LogisticRegression(C=1e6, max_iter=1000)
-        folds = cross_val_predict(model, x, y, cv=5, method="predict_proba")[:, 1]
-        model.fit(x, y)
-        a, (b, c, d) = float(model.intercept_[0]), map(float, model.coef_[0])
-        fits[preset] = {"intercept": a, "slope": b, "uncorroborated": c, "far": d, "maps": int(len(y))}
+        model = LogisticRegression(C=1e6)
+        folds = cross_val_predict(model, x[:, :1], y, cv=5, method="predict_proba")[:, 1]
+        model.fit(x[:, :1], y)
+        a, b = float(model.intercept_[0]), float(model.coef_[0, 0])
+        fits[preset] = {"intercept": a, "slope": b, "maps": int(len(y))}
         print(f"{preset}: {len(y)} faulty maps, {int(y.sum())} right; Brier raw {np.mean((p - y) ** 2):.4f}, "
               f"recalibrated (5-fold) {np.mean((folds - y) ** 2):.4f}, constant {np.mean((y.mean() - y) ** 2):.4f}; "
               f"wrong maps said >= {CONFIDENT}: raw {int(((p >= CONFIDENT) & (y == 0)).sum())}, recalibrated "
-              f"{int(((folds >= CONFIDENT) & (y == 0)).sum())}; a = {a:.3f}, b = {b:.3f}, c = {c:.3f}, d = {d:.3f}")
+              f"{int(((folds >= CONFIDENT) & (y == 0)).sum())}; a = {a:.3f}, b = {b:.3f}")
+        if args.features:
+            for name, columns in (("logit p, f", [0, 2]), ("logit p, u, f", [0, 1, 2])):
+                more = cross_val_predict(LogisticRegression(C=1e6, max_iter=1000), x[:, columns], y, cv=5,
+                                         method="predict_proba")[:, 1]
+                print(f"  {name}: Brier (5-fold) {np.mean((more - y) ** 2):.4f}")
     if args.write:
         doc = {"format": FAULT_FORMAT, "presets": fits, "script": "lab/calibrate_faults.py",
                "fitted_on": f"{SUITE} tuning cases, {args.per_cell} per hole count and fault level (0-3 holes)"}

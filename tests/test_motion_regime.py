@@ -192,13 +192,13 @@ def test_platt_recalibration_of_a_reader_by_hand():
 
 
 def test_a_flickering_log_read_by_a_shipped_reader_gets_the_recalibrated_confidence():
-    from swarmtopo.readers.recalibrated import flicker_recalibration
+    from swarmtopo.readers.recalibrated import recalibration
 
     sim = st.simulate(st.random_arena(1, rng=2), 200, 20.0, motion=Brownian(diffusion=300.0), rng=1)
     trace = contact_trace(sim.log)
     shipped = map_encounters(trace, MapConfig(**FAST))
     raw = map_encounters(trace, MapConfig(**FAST), reader=_unshipped("trace"))
-    fit = flicker_recalibration("trace", st.load_classifier("trace"))
+    fit = recalibration("flicker", "trace", st.load_classifier("trace"))
     assert fit is not None and "flicker_recalibration" in shipped.classifier
     assert shipped.betti == raw.betti
     assert shipped.confidence[1] == pytest.approx(fit.scaled(raw.confidence[1]))

@@ -237,6 +237,12 @@ def test_the_map_warns_and_says_what_the_screen_did(swarm_log):
     assert doc["sensing"]["suspected"] and doc["sensing"]["dropped"] > 0
     assert any("false encounters" in w and "left out of the map" in w for w in doc["warnings"])
     assert tmap.n_events == faulty.n_events - doc["sensing"]["dropped"]
+    # read by the shipped reader: its beta_1 confidence through the faulty logs' Platt scaling
+    fit = doc["classifier"]["fault_recalibration"]
+    raw = st.load_classifier("default")
+    region = raw.read([w.diagram for w in tmap.regions[0].windows])
+    z = fit["intercept"] + fit["slope"] * np.log(region.confidence[1] / (1 - region.confidence[1]))
+    assert tmap.regions[0].confidence[1] == pytest.approx(1 / (1 + np.exp(-z)))
     kept = map_json(map_encounters(faulty, MapConfig(uncorroborated="keep", **FAST)))
     assert kept["sensing"]["uncorroborated_share"] is None and kept["log"]["events"] == faulty.n_events
     clean = map_json(map_encounters(swarm_log, MapConfig(**FAST)))

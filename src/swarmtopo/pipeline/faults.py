@@ -27,25 +27,26 @@ tuning cases (``lab/fault_screen.py``) this flags about 2 % of a clean log's enc
 and 94-96 % of false ones.
 
 Clean logs have a few uncorroborated encounters too (1-4 % on the accuracy benchmark's
-tuning cases: agents alone in a corner), but almost none whose detour is longer than
+tuning cases: agents alone in a corner), but few whose detour is longer than
 ``FAR_HOPS`` x H: a false encounter between far-apart agents has one.  The share of
 such *far* encounters is the evidence of false encounters: on 78 clean tuning logs of
-200-400 agents it is 0.01-0.36 % but in the sparsest cells (200 x 30 s: up to 0.7 %);
-0.4-0.8 % with 0.5 % false encounters, 0.8-1.2 % with 1 %.  Even 0.5 % of false
-encounters add holes that are not there (``lab/tune_faults.py``).  With
-``uncorroborated = "auto"`` (the default) a log of at least ``MIN_AGENTS`` agents
-whose far share exceeds ``CLEAN_FAR_SHARE`` has its uncorroborated encounters dropped
-before mapping, and a warning; so do a few clean logs of sparse swarms (losing 2-4 %
-of their encounters, which does not change their maps' accuracy: docs/accuracy.md).
-Every other log maps exactly as before.  Heavy losses (half the reports) in
-a sparse swarm can lengthen detours as much, so the warning names both.
+200-400 agents it is at most 0.7 % (in the sparsest cells, 200 x 30 s; 0.4 % in the
+others), and up to 1.1 % in shorter logs (200 agents x 20 s: events near the log's ends
+have fewer detours); 0.4-0.8 % with 0.5 % false encounters, 0.8-1.2 % with 1 %, 2 %
+and more with 3 %.  With ``uncorroborated = "auto"`` (the default) a log of at least
+``MIN_AGENTS`` agents whose far share exceeds ``CLEAN_FAR_SHARE`` has its
+uncorroborated encounters dropped before mapping, and a warning; every other log maps
+exactly as before.  False encounters under about 1 % are therefore not found, though
+they already add holes that are not there (docs/accuracy.md, "Faulty sensing").
+Heavy losses (half the reports) in a sparse swarm can lengthen detours as much, so the
+warning names both.
 
 Timing errors -- jitter, clock offsets -- and heavy losses leave far encounters rare
 but many encounters without a short detour: the share u rises from 1-4 % (clean
 tuning logs) to 4-10 % (1 s of jitter, offsets of up to 5 s, half the reports lost).
 A log whose u exceeds ``POOR_SHARE`` is mapped as it is, with a warning naming those
 faults.  A map of a log with either sign has its beta_1 confidence recalibrated on
-faulty logs (:func:`~swarmtopo.readers.recalibrated.fault_recalibration`).
+faulty logs (:func:`~swarmtopo.readers.recalibrated.recalibration`).
 """
 
 from __future__ import annotations
@@ -71,7 +72,8 @@ DETOUR_HOPS = 8.0
 FAR_HOPS = 12.0
 """Shortest detour of a *far* event, in hops H."""
 CLEAN_FAR_SHARE = 0.012
-"""Largest share of far events in a log taken as clean (module docstring)."""
+"""Largest share of far events in a log taken as clean: above every clean log measured
+(module docstring)."""
 POOR_SHARE = 0.06
 """Largest share u of uncorroborated events in a log taken as well sensed (module docstring)."""
 MAX_DROP_SHARE = 0.25

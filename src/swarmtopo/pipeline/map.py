@@ -33,7 +33,7 @@ from ..metric.graph import weighted_chains
 from ..metric.landmarks import MIN_LANDMARKS
 from ..readers.base import BettiReader
 from ..readers.beta0 import shipped_beta0_model
-from ..readers.recalibrated import Recalibrated, fault_recalibration, flicker_recalibration
+from ..readers.recalibrated import Recalibrated, recalibration
 from ..readers.registry import load_classifier, shipped_reader_for
 from ..topology.cycles import region_cycles
 from ..topology.embed import mds
@@ -102,10 +102,10 @@ def map_encounters(
     screen, log = screen_faults(log, config.uncorroborated, config.window)
     preset = getattr(reader, "shipped_preset", None)
     if screen.suspected and preset:  # faulty sensing first: its fit saw the faults, the flicker's did not
-        reader = fault_recalibration(preset, reader, screen.uncorroborated_share, screen.far_share) or reader
+        reader = recalibration("fault", preset, reader) or reader
     elif motion.regime == "flickering" and motion.merged and preset:
-        reader = flicker_recalibration(preset, reader) or reader
-    recalibration = reader.kind if isinstance(reader, Recalibrated) else None
+        reader = recalibration("flicker", preset, reader) or reader
+    recalibrated_for = reader.kind if isinstance(reader, Recalibrated) else None
     settings = resolve(log, config, reader)
     leash = leash_of(log)
     span = (float(settings.times[0]), float(settings.times[-1]))
@@ -162,15 +162,17 @@ def map_encounters(
     length, step = timeline_settings(timeline_config, settings.window_length[0])
     timeline = build_timeline(timeline_windows, length, step, betti, confidence, log,
                               note=None if timeline_windows else no_timeline_note(timeline_config, length))
-    warnings = (motion_warnings(motion, recalibration == "flicker") + fault_warnings(screen, recalibration == "fault")
+    warnings = (motion_warnings(motion, recalibrated_for == "flicker")
+                + fault_warnings(screen, recalibrated_for == "fault")
                 + silence_warnings(settings.times, settings.window_length[0]) + _extrapolation_warnings(betti))
     exploration = None
     if leash is not None and betti.get(1) is not None:
         exploration = stitch(timeline.windows, log.beacon, leash, length, step, len(regions), log.meta, span)
         if exploration.betti[1] is not None:  # the global map's count is the answer
             betti[1], confidence[1] = exploration.betti[1], None
-            warnings = (motion_warnings(motion, recalibration == "flicker")
-                        + fault_warnings(screen, recalibration == "fault") + silence_warnings(settings.times, settings.window_length[0]))
+            warnings = (motion_warnings(motion, recalibrated_for == "flicker")
+                        + fault_warnings(screen, recalibrated_for == "fault")
+                        + silence_warnings(settings.times, settings.window_length[0]))
     elif (log.beacon is None) != ("leash" not in log.meta):
         warnings.append("the log has " + ("a leader's track (beacon.csv) but no 'leash' in meta.json"
                                           if log.beacon is not None else "a 'leash' in meta.json but no beacon.csv")

@@ -16,14 +16,12 @@ are the reader's own.  A map's confidence is then the reader's combination of th
 recalibrated regions' (``map_confidence``), and its timeline's windows are read the
 same way.
 
-Faulty sensing (:mod:`swarmtopo.pipeline.faults`) is recalibrated likewise, with the
-fault screen's shares as two more terms:
-
-    p' = sigmoid(a + b logit p + c u + d f),
-
-u the share of uncorroborated encounters and f that of far ones, fitted per preset by
-``lab/calibrate_faults.py`` on the maps of the fault benchmark's tuning cases that the
-screen reads as faulty (``swarmtopo/data/fault-confidence.json``).
+Logs with faulty sensing (:mod:`swarmtopo.pipeline.faults`) are recalibrated the same
+way, with (a, b) fitted per preset by ``lab/calibrate_faults.py`` on the one-region maps
+of the fault benchmark's tuning cases that the screen reads as faulty
+(``swarmtopo/data/fault-confidence.json``).  The screen's shares as more terms of the
+fit did not lower its cross-validated Brier score (``lab/calibrate_faults.py
+--features``), so the fit is Platt scaling too.
 """
 
 from __future__ import annotations
@@ -40,6 +38,9 @@ from .base import BettiReader, RegionReading
 
 FLICKER_FORMAT = "swarmtopo-flicker-confidence/1"
 FAULT_FORMAT = "swarmtopo-fault-confidence/1"
+RECALIBRATIONS = {"flicker": ("flicker-confidence.json", FLICKER_FORMAT),
+                  "fault": ("fault-confidence.json", FAULT_FORMAT)}
+"""Per kind of log, the file of its fits (package data) and the file's format."""
 
 
 @dataclass(frozen=True)
@@ -75,29 +76,16 @@ class Recalibrated:
                                                                          "slope": self.slope, **self.provenance}}
 
 
-def flicker_recalibration(preset: str, reader: BettiReader) -> Recalibrated | None:
-    """The shipped preset ``preset``'s ``reader`` recalibrated for flickering logs (None:
-    no fit shipped for that preset)."""
-    fits = _fits("flicker-confidence.json", FLICKER_FORMAT)
+def recalibration(kind: str, preset: str, reader: BettiReader) -> Recalibrated | None:
+    """The shipped preset ``preset``'s ``reader`` recalibrated for ``kind`` of log
+    (``RECALIBRATIONS``: ``flicker`` or ``fault``); None: no fit shipped for that preset."""
+    name, form = RECALIBRATIONS[kind]
+    fits = _fits(name, form)
     if preset not in fits["presets"]:
         return None
     fit = fits["presets"][preset]
     return Recalibrated(reader, fit["intercept"], fit["slope"],
-                        {"maps": fit["maps"], "script": fits["script"], "fitted_on": fits["fitted_on"]})
-
-
-def fault_recalibration(preset: str, reader: BettiReader, uncorroborated: float, far: float) -> Recalibrated | None:
-    """The shipped preset ``preset``'s ``reader`` recalibrated for a log with faulty sensing
-    whose screen read shares ``uncorroborated`` (u) and ``far`` (f) (None: no fit shipped
-    for that preset)."""
-    fits = _fits("fault-confidence.json", FAULT_FORMAT)
-    if preset not in fits["presets"]:
-        return None
-    fit = fits["presets"][preset]
-    intercept = fit["intercept"] + fit["uncorroborated"] * uncorroborated + fit["far"] * far
-    return Recalibrated(reader, intercept, fit["slope"],
-                        {"uncorroborated_share": uncorroborated, "far_share": far, "maps": fit["maps"],
-                         "script": fits["script"], "fitted_on": fits["fitted_on"]}, kind="fault")
+                        {"maps": fit["maps"], "script": fits["script"], "fitted_on": fits["fitted_on"]}, kind=kind)
 
 
 @lru_cache(maxsize=2)
