@@ -23,16 +23,17 @@ itself, each edge costing its time gap |t_i - t_j| plus a hop H = ``HOP_GAPS`` x
 :func:`~swarmtopo.pipeline.motion.median_agent_gap`, so every length follows the
 log's own time scale, losses included).  An event whose detour is longer than
 ``DETOUR_HOPS`` x H is *uncorroborated* (u: their share).  On the fault benchmark's
-tuning cases (``lab/fault_screen.py``) this flags 1.5 % of a clean log's encounters and
-94-99 % of false ones.
+tuning cases (``lab/fault_screen.py``) this flags about 2 % of a clean log's encounters
+and 94-96 % of false ones.
 
 Clean logs have a few uncorroborated encounters too (1-4 % on the accuracy benchmark's
 tuning cases: agents alone in a corner), but few whose detour is longer than
 ``FAR_HOPS`` x H: a false encounter between far-apart agents has one.  The share of
 such *far* encounters is the evidence of false encounters: on 78 clean tuning logs of
 200-400 agents it is at most 0.7 % (in the sparsest cells, 200 x 30 s; 0.4 % in the
-others), and more in shorter logs (events near a log's ends have fewer detours);
-0.4-0.8 % with 0.5 % false encounters, 0.8-1.1 % with 1 %, 1.8-2.4 % with 3 %.  With ``uncorroborated = "auto"`` (the default) a log of at least
+others), and up to 1.1 % in shorter logs (200 agents x 20 s: events near the log's ends
+have fewer detours); 0.4-0.8 % with 0.5 % false encounters, 0.8-1.2 % with 1 %, 2 %
+and more with 3 %.  With ``uncorroborated = "auto"`` (the default) a log of at least
 ``MIN_AGENTS`` agents whose far share exceeds ``CLEAN_FAR_SHARE`` has its
 uncorroborated encounters dropped before mapping, and a warning; every other log maps
 exactly as before.  False encounters under about 1 % are therefore not found, though
@@ -77,8 +78,8 @@ POOR_SHARE = 0.06
 """Largest share u of uncorroborated events in a log taken as well sensed (module docstring)."""
 MAX_DROP_SHARE = 0.25
 """Largest share u the screen drops: beyond it the log is too sparse for detours to tell
-false encounters from true ones (every log of the fault benchmark stays under 0.16),
-and nothing is dropped."""
+false encounters from true ones (every fault level of the fault benchmark's tuning cases
+stays under 0.14), and nothing is dropped."""
 
 
 @dataclass(frozen=True)
@@ -209,6 +210,8 @@ def detours(log: EncounterLog, hop: float, radius: float) -> np.ndarray:
 
 @njit(cache=True)
 def _detours(t, prev, nxt, hop, radius):
+    # the relaxation is written out at both places: a helper returning (size, n_touched)
+    # measured 1.8x slower (benchmarks/bench_fault_screen.py)
     m = len(t)
     dist = np.full(m, np.inf)
     touched = np.empty(m, np.int64)
@@ -220,7 +223,13 @@ def _detours(t, prev, nxt, hop, radius):
         n_touched = 0
         for v in (prev[e, 0], nxt[e, 0]):  # agent a's events around e
             if v >= 0:
-                size, n_touched = _improve(v, abs(t[e] - t[v]) + hop, dist, touched, n_touched, keys, nodes, size)
+                d = abs(t[e] - t[v]) + hop
+                if d < dist[v]:
+                    if dist[v] == np.inf:
+                        touched[n_touched] = v
+                        n_touched += 1
+                    dist[v] = d
+                    size = _heap_push(keys, nodes, size, d, v)
         best = np.inf
         while size > 0:
             d = keys[0]
@@ -236,22 +245,14 @@ def _detours(t, prev, nxt, hop, radius):
             for s in range(2):
                 for v in (prev[u, s], nxt[u, s]):
                     if v >= 0 and v != e:
-                        size, n_touched = _improve(v, d + abs(t[u] - t[v]) + hop, dist, touched, n_touched, keys,
-                                                   nodes, size)
+                        nd = d + abs(t[u] - t[v]) + hop
+                        if nd < dist[v]:
+                            if dist[v] == np.inf:
+                                touched[n_touched] = v
+                                n_touched += 1
+                            dist[v] = nd
+                            size = _heap_push(keys, nodes, size, nd, v)
         for i in range(n_touched):
             dist[touched[i]] = np.inf
         out[e] = best if best <= radius else np.inf
     return out
-
-
-@njit(cache=True)
-def _improve(v, d, dist, touched, n_touched, keys, nodes, size):
-    """Reach event ``v`` at ``d`` if that beats its distance so far (recording it as
-    touched the first time); returns (heap size, n_touched)."""
-    if d < dist[v]:
-        if dist[v] == np.inf:
-            touched[n_touched] = v
-            n_touched += 1
-        dist[v] = d
-        size = _heap_push(keys, nodes, size, d, v)
-    return size, n_touched
