@@ -16,7 +16,7 @@ from swarmtopo.experiments.grid import expand_grid
 from swarmtopo.log import EncounterLog
 from swarmtopo.pipeline import MapConfig, map_encounters
 from swarmtopo.pipeline.faults import CLEAN_FAR_SHARE, detours, fault_warnings, screen_faults
-from swarmtopo.sim.faults import Faults, perturb
+from swarmtopo.sim.faults import Faults, _false_reports, perturb
 from swarmtopo.viz.summary import map_json
 
 from conftest import run_cli
@@ -328,3 +328,25 @@ def test_the_fault_benchmark_runs_resumes_and_reports(tmp_path):
     assert f"Target ({bench.TARGET})" in text and "| none | 1 |" in text
     bench.plot(summary, tmp_path / "faults.png")
     assert (tmp_path / "faults.png").stat().st_size > 10_000
+
+
+def test_edge_cases_of_the_faults_and_the_screen():
+    # outages start in their stationary state: a radio is down at the log's start a share F of the time
+    log = once_per_pair(n_agents=400, n_events=4000, t0=0.0, span=1.0)
+    record = perturb(log, Faults(burst_lost=0.5, burst_length=10.0), 2)[1]["counts"]
+    assert abs(record["lost_in_outages"] / log.n_events - 0.5) < 0.05
+    with pytest.raises(InputError, match="burst_length must be at least"):
+        Faults(burst_lost=0.1, burst_length=1e-4)
+    # false encounters join living agents only: after t = 5 only agents 0-2 live, after t = 8 none
+    small = once_per_pair(n_agents=20, n_events=50)
+    death = np.where(np.arange(20) < 3, 8.0, 5.0)
+    t, a, b = _false_reports(np.random.default_rng(1), 400, 0.0, 10.0, death, small)
+    assert len(t) < 400 and t.max() < 8.0  # none drawn where fewer than two are alive
+    late = t > 5.0
+    assert late.any() and np.all(np.maximum(a[late], b[late]) < 3)
+    # a log of repeats only: merged, then nothing left to read, and no crash
+    t = np.repeat(np.arange(60) * 10.0, 2) + np.tile([0.0, 0.001], 60)
+    pairs = np.repeat(np.arange(60), 2)
+    repeats = EncounterLog.from_records(t, 2 * pairs, 2 * pairs + 1)
+    screen, mapped = screen_faults(repeats, "drop")
+    assert screen.merged == 60 and screen.uncorroborated_share is None and mapped.n_events == 60

@@ -217,10 +217,14 @@ def run_job(job: Job, keep: str = "map") -> dict[str, Any]:
             leader = {"leash": swarm["leash"],
                       "beacon": long_axis_track(arena.bounds, swarm["leash"], swarm["leader_speed"])}
         sim = simulate(arena, **job_simulation_args(swarm), **leader, rng=seeds["simulation"])
-        log = perturb(sim.log, Faults(**config["faults"]), seeds["faults"])[0] if "faults" in config else sim.log
+        log, shift = sim.log, 0.0
+        if "faults" in config:
+            log, record = perturb(sim.log, Faults(**config["faults"]), seeds["faults"])
+            shift = record["shift"]  # every time of the perturbed log moved by it
         row["t_simulate"] = time.perf_counter() - t0
         row["n_events"], row["n_agents"] = log.n_events, log.n_agents
-        true_timeline = betti_timeline_of(arena, sim.log.meta["duration"])
+        true_timeline = [{**segment, "from": segment["from"] + shift, "until": segment["until"] + shift}
+                         for segment in betti_timeline_of(arena, sim.log.meta["duration"])]
         log = stripped_log(log)
         tmap = map_encounters(contact_trace(log) if map_input(mapping) == "contact-trace" else log,
                               job_map_config(mapping, seeds["map"]),

@@ -151,6 +151,8 @@ def screen_faults(log: EncounterLog, mode: str = "auto",
         inside = slice(0, log.n_events) if window is None else slice(*event_slice(log, window))
         mapped = replace(log, t=log.t[inside], a=log.a[inside], b=log.b[inside])
         gap = median_agent_gap(mapped)
+        if gap is None:  # nothing but repeats: no detour to read
+            return FaultScreen(None, None, repeats, False, 0, merged), log
     hop = HOP_GAPS * gap
     detour = detours(mapped, hop, FAR_HOPS * hop) / hop
     lone = np.zeros(log.n_events, bool)
@@ -181,11 +183,15 @@ def fault_warnings(screen: FaultScreen, recalibrated: bool) -> list[str]:
                    f"swarm, heavy losses) are suspected; the {screen.dropped} uncorroborated encounters were left "
                    f"out of the map, and {trust} {where}")
     elif screen.poorly_corroborated:
-        sparse = (", or the swarm is too sparse for its encounters to back each other (nothing was left out)"
+        sparse = ((", or the swarm is too sparse for its encounters to back each other"
+                   + ("" if screen.dropped else " (nothing was left out)"))
                   if screen.uncorroborated_share > MAX_DROP_SHARE else "")
         out.append(f"{100 * screen.uncorroborated_share:.1f} % of the encounters have no short detour through the "
                    f"rest of the log (clean logs stay under {100 * POOR_SHARE:g} %): timing errors (jitter, clock "
                    f"offsets) or heavy losses are suspected{sparse}; the map is less certain, and {trust} {where}")
+    if screen.dropped and not screen.false_encounters:  # dropped on request (uncorroborated = drop)
+        out.append(f"{screen.dropped} uncorroborated encounters were left out of the map (uncorroborated = drop) "
+                   f"{where}")
     return out
 
 

@@ -36,9 +36,12 @@ with the reporter's clock.  The faults, in the order they act:
 
 Log times are not negative: if a stamp falls before 0 s, every time of the log (stamps,
 status changes, static times, a leader's track, ``duration``) is shifted by one
-constant so that the earliest is 0 s (the record's ``shift``).  Each fault draws from its own random stream (spawned from
-``seed``), so changing one fault's level leaves the others' draws as they were, and
-the same log, faults and seed give the same output.
+constant so that the earliest is 0 s (the record's ``shift``).  Each fault draws from
+its own random stream (spawned from ``seed``), and the same log, faults and seed give
+the same output.  The reporters, deaths, losses and outages are drawn per report of the
+input log, so they do not depend on the other faults' levels (the same reports are
+lost whatever the jitter); duplicates, false encounters, clocks and jitter are drawn
+per delivered report, so they change when the losses do.
 """
 
 from __future__ import annotations
@@ -53,6 +56,8 @@ from .._validate import fraction, non_negative
 from ..errors import InputError
 from ..log import EncounterLog
 
+MIN_BURST_LENGTH = 0.01
+"""Shortest mean outage (s): the outages are drawn one by one."""
 FALSE_PAIR_TRIES = 20
 """Draws of a false encounter's pair before one that met elsewhere in the log is kept."""
 FAULT_SHARES = ("lost", "burst_lost", "false_encounters", "dying", "duplicated")
@@ -87,8 +92,9 @@ class Faults:
                              value=self.burst_lost)
         for name in ("burst_length", "jitter", "clock_offset", "clock_drift", "duplicate_delay"):
             object.__setattr__(self, name, non_negative(f"faults.{name}", getattr(self, name)))
-        if self.burst_length == 0 and self.burst_lost > 0:
-            raise InputError("faults.burst_length must be positive when burst_lost is", value=self.burst_length)
+        if self.burst_length < MIN_BURST_LENGTH and self.burst_lost > 0:
+            raise InputError(f"faults.burst_length must be at least {MIN_BURST_LENGTH:g} s when burst_lost is "
+                             "positive (shorter outages are independent losses: use lost)", value=self.burst_length)
         if self.clock_drift >= 1:
             raise InputError("faults.clock_drift must be below 1 s per s (a clock that runs backwards)",
                              value=self.clock_drift)
@@ -132,6 +138,7 @@ def perturb(log: EncounterLog, faults: Faults, seed: int = 0) -> tuple[Encounter
 
     n_false = int(rng["false"].binomial(len(t), faults.false_encounters)) if faults.false_encounters and n >= 2 else 0
     ft, fa, fb = _false_reports(rng["false"], n_false, t0, t1, death, log)
+    n_false = len(ft)
     t, a, b = np.concatenate([t, ft]), np.concatenate([a, fa]), np.concatenate([b, fb])
     rep = np.concatenate([rep, np.where(rng["false"].random(len(ft)) < 0.5, fa, fb)])
 
@@ -174,8 +181,8 @@ def _outages(rng, n: int, t0: float, t1: float, share: float, length: float) -> 
     up_mean = length * (1 - share) / share
     out = []
     for _ in range(n):
-        down = rng.random() < share
-        t, spans = t0 - (rng.exponential(length) if down else 0.0), []
+        down = rng.random() < share  # the stationary state at t0; exponential times are memoryless
+        t, spans = t0, []
         while t < t1:
             if down:
                 end = t + rng.exponential(length)
@@ -203,19 +210,21 @@ def _in_outage(down: list[np.ndarray], reporter: np.ndarray, t: np.ndarray) -> n
 
 
 def _false_reports(rng, count: int, t0: float, t1: float, death: np.ndarray, log: EncounterLog):
-    """``count`` false reports (t, a, b): pairs of agents alive at t that never met in the
-    log, where ``FALSE_PAIR_TRIES`` draws find one."""
+    """Up to ``count`` false reports (t, a, b): pairs of agents alive at t that never met in
+    the log, where ``FALSE_PAIR_TRIES`` draws find one; a time with fewer than two agents
+    alive gets none."""
     n = log.n_agents
     met = set((log.a * n + log.b).tolist())
     t = rng.uniform(t0, t1, count)
-    a, b = np.empty(count, np.int64), np.empty(count, np.int64)
+    a, b = np.full(count, -1, np.int64), np.full(count, -1, np.int64)
     for i in range(count):
         living = np.flatnonzero(death > t[i])
         if len(living) < 2:
-            living = np.arange(n)
+            continue
         for _ in range(FALSE_PAIR_TRIES):
             x, y = rng.choice(living, 2, replace=False)
             if min(x, y) * n + max(x, y) not in met:
                 break
         a[i], b[i] = min(x, y), max(x, y)
-    return t, a, b
+    drawn = a >= 0
+    return t[drawn], a[drawn], b[drawn]
