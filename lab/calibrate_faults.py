@@ -26,7 +26,7 @@ import numpy as np
 from sklearn.linear_model import LogisticRegression
 from sklearn.model_selection import cross_val_predict
 
-from calibrate_flicker import clipped_logit
+from calibrate_flicker import clipped_logit, platt_fit
 from swarmtopo.experiments.accuracy import PIPELINES, TRACE_PIPELINE
 from swarmtopo.experiments.faults import SUITE, jobs
 from swarmtopo.experiments.store import read_jobs
@@ -72,15 +72,8 @@ def main() -> None:
         run_sweep(todo, args.store, workers=args.workers, keep="windows")
         rows = read_jobs(args.store, columns=COLUMNS, keys=[job.key for job in todo])
         x, y, p = raw_confidences(rows, preset)
-        model = LogisticRegression(C=1e6)
-        folds = cross_val_predict(model, x[:, :1], y, cv=5, method="predict_proba")[:, 1]
-        model.fit(x[:, :1], y)
-        a, b = float(model.intercept_[0]), float(model.coef_[0, 0])
-        fits[preset] = {"intercept": a, "slope": b, "maps": int(len(y))}
-        print(f"{preset}: {len(y)} faulty maps, {int(y.sum())} right; Brier raw {np.mean((p - y) ** 2):.4f}, "
-              f"recalibrated (5-fold) {np.mean((folds - y) ** 2):.4f}, constant {np.mean((y.mean() - y) ** 2):.4f}; "
-              f"wrong maps said >= {CONFIDENT}: raw {int(((p >= CONFIDENT) & (y == 0)).sum())}, recalibrated "
-              f"{int(((folds >= CONFIDENT) & (y == 0)).sum())}; a = {a:.3f}, b = {b:.3f}")
+        fits[preset], line = platt_fit(p, y, "faulty", CONFIDENT)
+        print(f"{preset}: {line}")
         if args.features:
             for name, columns in (("logit p, f", [0, 2]), ("logit p, u, f", [0, 1, 2])):
                 more = cross_val_predict(LogisticRegression(C=1e6, max_iter=1000), x[:, columns], y, cv=5,

@@ -41,6 +41,22 @@ def clipped_logit(p: np.ndarray) -> np.ndarray:
     return np.log(p / (1 - p))
 
 
+def platt_fit(p: np.ndarray, y: np.ndarray, what: str, confident: float) -> tuple[dict, str]:
+    """Platt scaling of the confidences ``p`` on the outcomes ``y``: the fit (intercept a,
+    slope b, maps) and a line with its 5-fold cross-validated Brier score against the raw
+    confidence and a constant, and the wrong maps said at ``confident`` or more."""
+    x = clipped_logit(p)[:, None]
+    model = LogisticRegression(C=1e6)
+    folds = cross_val_predict(model, x, y, cv=5, method="predict_proba")[:, 1]
+    model.fit(x, y)
+    fit = {"intercept": float(model.intercept_[0]), "slope": float(model.coef_[0, 0]), "maps": int(len(y))}
+    line = (f"{len(y)} {what} maps, {int(y.sum())} right; Brier raw {np.mean((p - y) ** 2):.4f}, "
+            f"recalibrated (5-fold) {np.mean((folds - y) ** 2):.4f}, constant {np.mean((y.mean() - y) ** 2):.4f}; "
+            f"wrong maps said >= {confident:g}: raw {int(((p >= confident) & (y == 0)).sum())}, recalibrated "
+            f"{int(((folds >= confident) & (y == 0)).sum())}; a = {fit['intercept']:.3f}, b = {fit['slope']:.3f}")
+    return fit, line
+
+
 def raw_confidences(rows, preset: str) -> tuple[np.ndarray, np.ndarray]:
     """(raw map confidence of beta_1, beta_1 right) of the flickering maps among ``rows``."""
     reader = load_classifier(preset)
@@ -73,16 +89,8 @@ def main() -> None:
         run_sweep(todo, args.store, workers=args.workers, keep="windows")
         rows = read_jobs(args.store, columns=COLUMNS, keys=[job.key for job in todo])
         p, y = raw_confidences(rows, preset)
-        x = clipped_logit(p)[:, None]
-        model = LogisticRegression(C=1e6)
-        folds = cross_val_predict(model, x, y, cv=5, method="predict_proba")[:, 1]
-        model.fit(x, y)
-        fits[preset] = {"intercept": float(model.intercept_[0]), "slope": float(model.coef_[0, 0]), "maps": int(len(y))}
-        print(f"{preset}: {len(y)} flickering maps, {int(y.sum())} right; Brier raw {np.mean((p - y) ** 2):.4f}, "
-              f"recalibrated (5-fold) {np.mean((folds - y) ** 2):.4f}, constant {np.mean((y.mean() - y) ** 2):.4f}; "
-              f"wrong maps said >= 0.9: raw {int(((p >= 0.9) & (y == 0)).sum())}, recalibrated "
-              f"{int(((folds >= 0.9) & (y == 0)).sum())}; a = {fits[preset]['intercept']:.3f}, "
-              f"b = {fits[preset]['slope']:.3f}")
+        fits[preset], line = platt_fit(p, y, "flickering", 0.9)
+        print(f"{preset}: {line}")
     if args.write:
         doc = {"format": FLICKER_FORMAT, "presets": fits, "script": "lab/calibrate_flicker.py",
                "fitted_on": f"{SUITE} tuning cases, {args.per_cell} per cell of {', '.join(MODELS)} (0-3 holes)"}

@@ -72,7 +72,7 @@ def faulty(args) -> list[tuple]:
     for hop, hops in RULES:
         lone = ~np.isfinite(detours(log, hop * gap, hops * hop * gap))
         rows.append(((hop, hops), lone.mean(), lone[~false].mean(), (~lone[false]).mean() if false.any() else None,
-                     screen.suspected, screen.duplicated, screen.far_share))
+                     screen.suspected, screen.duplicated, screen.far_share, screen.duplicate_share))
     return rows
 
 
@@ -96,8 +96,8 @@ def main() -> None:
                   f"{far.min():.4f} / {np.median(far):.4f} / {far.max():.4f} | {rep.max():.3f} | "
                   f"{int((far > CLEAN_FAR_SHARE).sum())} / {int((u > POOR_SHARE).sum())} / "
                   f"{int((rep > CLEAN_DUPLICATE_SHARE).sum())} |")
-        print("\n| faults | H/g, K | u | true flagged | false kept | far share min-max | read as faulty | "
-              "duplicates merged |\n|---|---|---|---|---|---|---|---|")
+        print("\n| faults | H/g, K | u | true flagged | false kept | far share min-max | repeats min-max | "
+              "read as faulty | duplicates merged |\n|---|---|---|---|---|---|---|---|---|")
         for level in TRIED:
             jobs = [(h, i, level) for h in HOLES for i in range(args.faulty)]
             rows = [r for case in pool.map(faulty, jobs) for r in case]
@@ -107,6 +107,7 @@ def main() -> None:
                 print(f"| {level or 'none'} | {rule[0]:g}, {rule[1]:g} | {np.mean([r[1] for r in mine]):.3f} | "
                       f"{np.mean([r[2] for r in mine]):.3f} | {np.mean(kept) if kept else float('nan'):.3f} | "
                       f"{min(r[6] for r in mine):.4f}-{max(r[6] for r in mine):.4f} | "
+                      f"{min(r[7] for r in mine):.3f}-{max(r[7] for r in mine):.3f} | "
                       f"{sum(r[4] for r in mine)}/{len(mine)} | {sum(r[5] for r in mine)}/{len(mine)} |")
 
 

@@ -7,8 +7,8 @@ of one hole family, the outer wall, a scale in [0.75, 1.25]) and a cockroach swa
 300 agents x 40 s.  The same case is then mapped at every fault ``LEVELS`` (its log
 perturbed by :func:`~swarmtopo.sim.faults.perturb` with the case's own faults stream,
 so one case's levels differ only by the faults), as a contact trace (the encounters
-only, ``TRACE_PIPELINE``).  ``CURVES`` vary one fault at a time over the issue's
-ranges; ``TOGETHER`` are faults together (the target: 50 % lost, 1 s jitter, 3 % false
+only, ``TRACE_PIPELINE``).  ``CURVES`` vary one fault at a time over its
+range; ``TOGETHER`` are faults together (the target: 50 % lost, 1 s jitter, 3 % false
 encounters and 20 % of agents dying).  Tuning and reporting seeds are split as in the
 accuracy benchmark; the held-out hole family is left out of tuning.
 """
@@ -21,9 +21,9 @@ from typing import Any
 import numpy as np
 
 from ..arena import HOLE_SHAPES, OUTER_SHAPES
-from ..sim.faults import Faults
+from ..sim.faults import FAULT_LEVELS
 from .accuracy import HELD_OUT_FAMILY, SCALE_RANGE, TRACE_PIPELINE, Rate, brier_gain, failures_text, percent_text
-from .grid import Job, suite_case_seed
+from .grid import Job, faults_table, suite_case_seed
 from .sweep import run_suite, suite_case, suite_jobs
 
 SUITE = "swarmtopo-faults/1"
@@ -45,7 +45,7 @@ TOGETHER: dict[str, dict[str, float]] = {
     "50 % lost, 1 s jitter, 3 % false, 20 % dying": {"lost": 0.5, "jitter": 1.0, "false_encounters": 0.03,
                                                       "dying": 0.2},
 }
-"""Faults together; the second is the issue's target (at least 90 % exact)."""
+"""Faults together; the second is the target mix (``TARGET``: at least 90 % exact)."""
 TARGET = "50 % lost, 1 s jitter, 3 % false, 20 % dying"
 REPORTING_PER_CELL = 4
 TOGETHER_PER_CELL = 10
@@ -120,12 +120,7 @@ def case(cell: Cell, split: str, index: int) -> tuple[dict[str, Any], int]:
     """(config tables with the level's ``[faults]``, case seed) of a case whose holes fit."""
     config, seed = suite_case(SUITE, _Case(cell.holes), split, index, case_config, MAX_ATTEMPTS)
     if cell.level.faults:
-        faults = dict(cell.level.faults)
-        if faults.get("burst_lost"):
-            faults["burst_length"] = Faults.burst_length
-        if faults.get("duplicated"):
-            faults["duplicate_delay"] = Faults.duplicate_delay
-        config["faults"] = faults
+        config["faults"] = faults_table(dict(cell.level.faults))
     return config, seed
 
 
@@ -147,7 +142,7 @@ def jobs(split: str, quick: bool = False, cells=CELLS, pipeline: dict[str, Any] 
 
 def level_of(config: dict[str, Any]) -> Level:
     """The level a job's config was made for."""
-    faults = {k: v for k, v in config.get("faults", {}).items() if k not in ("burst_length", "duplicate_delay")}
+    faults = {name: value for name, value in config.get("faults", {}).items() if name in FAULT_LEVELS}
     return next(level for level in LEVELS if dict(level.faults) == faults)
 
 
@@ -202,8 +197,10 @@ def run_benchmark(store, *, quick: bool = False, split: str = "reporting", per_c
     """Run (or resume) the cases of ``split`` (``per_cell``: that many per hole count at
     every level); the summary document (records and :func:`table`)."""
     todo = jobs(split, quick, cells, cases=per_cell)
-    cases = (per_cell or QUICK_PER_CELL if per_cell or quick
-             else {"levels": REPORTING_PER_CELL, "together": TOGETHER_PER_CELL})
+    if per_cell or quick:
+        cases = per_cell or QUICK_PER_CELL
+    else:
+        cases = {"levels": REPORTING_PER_CELL, "together": TOGETHER_PER_CELL}
     return run_suite(SUITE, split, cases, todo, store, records, table, {"budget": list(BUDGET)},
                      scheduler=scheduler, workers=workers, progress=progress, keep=keep)
 

@@ -618,15 +618,24 @@ def _canonical(point: dict, inputs: _InputFiles, fail):
         files.append(("map.classifier", absolute))
 
     config = {"arena": arena, "swarm": swarm, "map": mapping}
-    faults = {name: point[("faults", name)] for name in FAULT_LEVELS}
-    if any(faults.values()):  # a job without faults has the config it had before faults existed
-        config["faults"] = {name: value for name, value in faults.items() if value}
-        for name, level in (("burst_length", "burst_lost"), ("duplicate_delay", "duplicated")):
-            if faults[level]:
-                config["faults"][name] = point[("faults", name)]
+    faults = faults_table({name: point[("faults", name)] for name in Faults.__dataclass_fields__})
+    if faults:  # a job without faults has the config it had before faults existed
+        config["faults"] = faults
     used = ({(table, key) for table, body in config.items() for key in body} | {("swarm", "leash")}  # 0: no leader
             | {("faults", name) for name in FAULT_LEVELS})  # 0: no such fault
     return config, tuple(files), used
+
+
+def faults_table(values: dict[str, float]) -> dict[str, float]:
+    """The canonical ``[faults]`` table of a job from ``Faults`` field values (missing:
+    the defaults): its non-zero levels, with ``burst_length`` and ``duplicate_delay`` only
+    when they shape outages or duplicates; empty without a fault."""
+    values = {**Faults().to_json(), **values}
+    table = {name: values[name] for name in FAULT_LEVELS if values[name]}
+    for name, level in (("burst_length", "burst_lost"), ("duplicate_delay", "duplicated")):
+        if values[level]:
+            table[name] = values[name]
+    return table
 
 
 def _check_job(config: dict, document: dict, fail) -> None:

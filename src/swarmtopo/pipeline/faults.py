@@ -4,7 +4,7 @@ A duplicated report -- one contact reported twice, a moment apart -- is a pair m
 again within a gap or two, which a walker seldom does: on 78 clean cockroach logs of
 the accuracy benchmark's tuning cases (200-400 agents) at most 3.9 % of the events repeat
 their pair's within ``DUPLICATE_GAPS`` x g (g the median agent gap; 2 % but in the
-sparsest cells), against 9-10 % with 10 % of the reports duplicated
+sparsest cells), against 9-11 % with 10 % of the reports duplicated
 (``lab/fault_screen.py``).  Beyond ``CLEAN_DUPLICATE_SHARE`` such repeats are merged into their pair's
 first event before anything else (their tiny gaps would shrink g, and with it every
 time scale of the map).
@@ -88,16 +88,20 @@ class FaultScreen:
 
     The shares are None for a swarm of fewer than ``MIN_AGENTS`` (not read);
     ``merged`` is how many repeats were merged as duplicated reports, ``dropped`` how
-    many uncorroborated events were left out of the map; ``suspected``: the log shows
-    false encounters, timing errors or heavy losses (its confidence is recalibrated).
+    many uncorroborated events were left out of the map.
     """
 
     uncorroborated_share: float | None
     far_share: float | None
     duplicate_share: float | None
-    suspected: bool
     dropped: int
     merged: int
+
+    @property
+    def suspected(self) -> bool:
+        """Whether the log shows false encounters, timing errors or heavy losses (a map of
+        it has its confidence recalibrated)."""
+        return self.false_encounters or self.poorly_corroborated
 
     @property
     def duplicated(self) -> bool:
@@ -134,7 +138,7 @@ def screen_faults(log: EncounterLog, mode: str = "auto",
     ``CLEAN_DUPLICATE_SHARE``, then uncorroborated events dropped when its share of far
     events exceeds ``CLEAN_FAR_SHARE`` (``mode`` ``auto``); ``drop`` does both whatever
     the shares, ``keep`` reads nothing."""
-    unread = FaultScreen(None, None, None, False, 0, 0)
+    unread = FaultScreen(None, None, None, 0, 0)
     if mode == "keep" or log.n_agents < MIN_AGENTS and mode == "auto":
         return unread, log
     inside = slice(0, log.n_events) if window is None else slice(*event_slice(log, window))
@@ -152,17 +156,17 @@ def screen_faults(log: EncounterLog, mode: str = "auto",
         mapped = replace(log, t=log.t[inside], a=log.a[inside], b=log.b[inside])
         gap = median_agent_gap(mapped)
         if gap is None:  # nothing but repeats: no detour to read
-            return FaultScreen(None, None, repeats, False, 0, merged), log
+            return FaultScreen(None, None, repeats, 0, merged), log
     hop = HOP_GAPS * gap
     detour = detours(mapped, hop, FAR_HOPS * hop) / hop
     lone = np.zeros(log.n_events, bool)
     lone[inside] = detour > DETOUR_HOPS
     share, far = float(lone[inside].mean()), float(np.mean(detour > FAR_HOPS))
-    suspected = far > CLEAN_FAR_SHARE or share > POOR_SHARE
-    if not (mode == "drop" or far > CLEAN_FAR_SHARE and share <= MAX_DROP_SHARE):
-        return FaultScreen(share, far, repeats, suspected, 0, merged), log
+    screen = FaultScreen(share, far, repeats, 0, merged)
+    if not (mode == "drop" or screen.false_encounters):
+        return screen, log
     keep = ~lone
-    return (FaultScreen(share, far, repeats, suspected, int(lone.sum()), merged),
+    return (replace(screen, dropped=int(lone.sum())),
             replace(log, t=log.t[keep], a=log.a[keep], b=log.b[keep]))
 
 
